@@ -1,0 +1,23 @@
+// cli: the `mimic2d` front end. Each file adds one subcommand; settings are
+// parsed here, at the edge, into the typed Options structs of the library.
+#ifndef MIMIC2D_CLI_COMMANDS_H_
+#define MIMIC2D_CLI_COMMANDS_H_
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace m2d::cli {
+
+// A subcommand's body; returns the process exit code.
+using CommandRun = std::function<int()>;
+
+// Each registers its subcommand on `app` and stores its body in `*run`.
+void AddClipCommand(CLI::App& app, CommandRun* run);
+void AddDemoCommand(CLI::App& app, CommandRun* run);
+
+// Where assets/ lives: $MIMIC2D_ASSETS, else the source tree's assets/.
+std::string AssetPath(const std::string& relative);
+
+}  // namespace m2d::cli
+
+#endif  // MIMIC2D_CLI_COMMANDS_H_

@@ -1,0 +1,114 @@
+#include "cli/motion_source.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "common/error.h"
+#include "motion/motion_io.h"
+
+namespace m2d::cli {
+
+void AddMotionSourceOptions(CLI::App& command, MotionSourceArgs* args) {
+  command.add_option("motion", args->path, "3D motion: DeepMimic .txt or .bvh")
+      ->required();
+  command.add_option("--skeleton", args->skeleton,
+                     "Skeleton YAML for DeepMimic files (default: "
+                     "assets/skeletons/humanoid.yaml)");
+  command.add_option(
+      "--keypoint-map", args->keypoint_map,
+      "Keypoint map YAML (default: humanoid or CMU BVH COCO-17 map)");
+  command
+      .add_option("--bvh-scale", args->bvh_scale_m,
+                  "Metres per BVH length unit")
+      ->capture_default_str();
+}
+
+void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
+                      bool* follow) {
+  RigOptions& rig = options->rig;
+  command.add_option("--fps", options->fps, "Frame rate of the 2D clips (Hz)")
+      ->capture_default_str();
+  command.add_option("--duration", options->duration_s,
+                     "Clip length in seconds; longer than the motion loops a "
+                     "looping motion (0: as is)");
+  command.add_option("--views", rig.num_views, "Number of camera views")
+      ->capture_default_str();
+  command
+      .add_option("--first-azimuth", rig.first_azimuth_deg,
+                  "Azimuth of view 0 (deg)")
+      ->capture_default_str();
+  command
+      .add_option("--azimuth-span", rig.azimuth_span_deg,
+                  "Views spread over this arc (deg)")
+      ->capture_default_str();
+  command
+      .add_option("--elevation", rig.elevation_deg, "Camera elevation (deg)")
+      ->capture_default_str();
+  command
+      .add_option("--distance", rig.distance_m,
+                  "Camera distance to the subject (m)")
+      ->capture_default_str();
+  command.add_option("--focal", rig.focal_px, "Focal length (px)")
+      ->capture_default_str();
+  command.add_option("--width", rig.width_px, "Image width (px)")
+      ->capture_default_str();
+  command.add_option("--height", rig.height_px, "Image height (px)")
+      ->capture_default_str();
+  command.add_flag("--follow", *follow,
+                   "Cameras dolly along with the subject's ground path");
+  command.add_option("--noise-px", options->noise.pixel_sigma_px,
+                     "Detector noise: Gaussian sigma (px)");
+  command.add_option("--drop", options->noise.drop_probability,
+                     "Detector noise: probability a keypoint is missed");
+  command.add_option(
+      "--jitter-frames", options->noise.time_jitter_frames,
+      "Detector noise: std. dev. of per-frame timing jitter (frames)");
+  command
+      .add_option("--seed", options->noise.seed, "Seed of the detector noise")
+      ->capture_default_str();
+}
+
+LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
+  std::string extension = std::filesystem::path(args.path).extension().string();
+  LoadedMotion loaded;
+  if (extension == ".bvh" || extension == ".BVH") {
+    if (!(args.bvh_scale_m > 0)) {
+      throw ConfigError("--bvh-scale must be positive");
+    }
+    loaded.motion = ReadBvhMotion(args.path, args.bvh_scale_m);
+    std::string map_path = args.keypoint_map.empty()
+                               ? AssetPath("skeletons/cmu_bvh.coco17.yaml")
+                               : args.keypoint_map;
+    loaded.keypoint_map = LoadKeypointMap(map_path, *loaded.motion.skeleton);
+    return loaded;
+  }
+  std::string skeleton_path = args.skeleton.empty()
+                                  ? AssetPath("skeletons/humanoid.yaml")
+                                  : args.skeleton;
+  auto skeleton = std::make_shared<const Skeleton>(LoadSkeleton(skeleton_path));
+  loaded.motion = ReadDeepMimicMotion(args.path, skeleton);
+  std::string map_path = args.keypoint_map.empty()
+                             ? AssetPath("skeletons/humanoid.coco17.yaml")
+                             : args.keypoint_map;
+  loaded.keypoint_map = LoadKeypointMap(map_path, *skeleton);
+  return loaded;
+}
+
+void PrintBundleSummary(const ReferenceBundle& bundle,
+                        const std::string& path) {
+  std::printf("%s: bundle '%s', %zu views, %d frames at %.1f fps (%.2f s)%s\n",
+              path.c_str(), bundle.name.c_str(), bundle.views.size(),
+              bundle.num_frames(), bundle.fps, bundle.num_frames() / bundle.fps,
+              bundle.ground_truth ? ", 3D ground truth" : "");
+  std::printf("  %-8s %8s %10s %10s %12s\n", "view", "frames", "present%",
+              "in-image%", "height(px)");
+  for (const ViewSummary& view : SummarizeBundle(bundle)) {
+    std::printf("  %-8s %8d %10.1f %10.1f %12.1f\n", view.name.c_str(),
+                view.num_frames, 100 * view.present_fraction,
+                100 * view.in_image_fraction, view.mean_height_px);
+  }
+}
+
+}  // namespace m2d::cli

@@ -1,0 +1,34 @@
+// cli: shared options for reading a 3D motion and making a bundle from it.
+#ifndef MIMIC2D_CLI_MOTION_SOURCE_H_
+#define MIMIC2D_CLI_MOTION_SOURCE_H_
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "motion/bundle.h"
+#include "motion/motion3d.h"
+#include "motion/skeleton.h"
+
+namespace m2d::cli {
+
+struct MotionSourceArgs {
+  std::string path;               // .txt (DeepMimic) or .bvh
+  std::string skeleton;           // DeepMimic: skeleton YAML
+  std::string keypoint_map;       // keypoint map YAML
+  double bvh_scale_m = 0.056444;  // metres per BVH unit (CMU/cgspeed)
+};
+
+struct LoadedMotion {
+  Motion3D motion;
+  KeypointMap keypoint_map;
+};
+
+void AddMotionSourceOptions(CLI::App& command, MotionSourceArgs* args);
+void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
+                      bool* follow);
+LoadedMotion LoadMotionSource(const MotionSourceArgs& args);
+void PrintBundleSummary(const ReferenceBundle& bundle, const std::string& path);
+
+}  // namespace m2d::cli
+
+#endif  // MIMIC2D_CLI_MOTION_SOURCE_H_

@@ -1,0 +1,107 @@
+#include "common/file_io.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.h"
+
+namespace m2d {
+
+std::string ReadFileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(
+        path, std::string("cannot open file (") + std::strerror(errno) + ")");
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+void WriteFileAtomic(const std::string& path, const std::string& contents) {
+  // Outline: write a sibling temp file, fsync it, rename over the target,
+  // fsync the folder so the rename itself survives a power loss.
+  std::filesystem::path target(path);
+  std::filesystem::path folder = target.parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  std::string temp = path + ".tmp." + std::to_string(::getpid());
+
+  int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) {
+    throw InputError(
+        path, std::string("cannot write (") + std::strerror(errno) + ")");
+  }
+  const char* data = contents.data();
+  size_t remaining = contents.size();
+  while (remaining > 0) {
+    ssize_t written = ::write(fd, data, remaining);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      int saved = errno;
+      ::close(fd);
+      ::unlink(temp.c_str());
+      throw InputError(
+          path, std::string("write failed (") + std::strerror(saved) + ")");
+    }
+    data += written;
+    remaining -= static_cast<size_t>(written);
+  }
+  ::fsync(fd);
+  ::close(fd);
+  if (::rename(temp.c_str(), path.c_str()) != 0) {
+    int saved = errno;
+    ::unlink(temp.c_str());
+    throw InputError(
+        path, std::string("rename failed (") + std::strerror(saved) + ")");
+  }
+  int dir_fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::string text = ReadFileText(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, std::string("malformed JSON: ") + e.what());
+  }
+}
+
+void WriteJsonFileAtomic(const std::string& path, const nlohmann::json& json,
+                         int indent) {
+  WriteFileAtomic(path, json.dump(indent) + "\n");
+}
+
+YAML::Node ReadYamlFile(const std::string& path) {
+  std::string text = ReadFileText(path);
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, std::string("malformed YAML: ") + e.what());
+  }
+}
+
+std::string ParentDirectory(const std::string& path) {
+  std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
+
+std::string ResolveRelative(const std::string& base_file,
+                            const std::string& relative) {
+  std::filesystem::path rel(relative);
+  if (rel.is_absolute()) return relative;
+  return (std::filesystem::path(ParentDirectory(base_file)) / rel).string();
+}
+
+}  // namespace m2d

@@ -1,0 +1,382 @@
+#include "motion/bundle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "camera/camera_io.h"
+#include "common/error.h"
+#include "common/file_io.h"
+#include "common/json_fields.h"
+#include "motion/clip_io.h"
+
+namespace m2d {
+namespace {
+
+nlohmann::json Vector3ToJson(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+Eigen::Vector3d Vector3FromJson(const JsonCursor& cursor) {
+  cursor.ArraySize(3);
+  return {cursor.At(0).Number(), cursor.At(1).Number(), cursor.At(2).Number()};
+}
+
+nlohmann::json GroundTruthToJson(const GroundTruth3D& truth) {
+  nlohmann::json keypoints = nlohmann::json::array();
+  for (const auto& frame : truth.keypoints_m) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const Eigen::Vector3d& p : frame) points.push_back(Vector3ToJson(p));
+    keypoints.push_back(points);
+  }
+  nlohmann::json json = {{"layout", truth.layout->name},
+                         {"keypoints_m", keypoints}};
+  if (!truth.poses.empty()) {
+    nlohmann::json poses = nlohmann::json::array();
+    for (const Pose3D& pose : truth.poses) {
+      nlohmann::json rotations = nlohmann::json::array();
+      for (const Eigen::Quaterniond& q : pose.local_rotations) {
+        rotations.push_back({q.w(), q.x(), q.y(), q.z()});
+      }
+      poses.push_back({{"root_position_m", Vector3ToJson(pose.root_position_m)},
+                       {"local_rotations_wxyz", rotations}});
+    }
+    json["skeleton"] = truth.skeleton_name;
+    json["poses"] = poses;
+  }
+  return json;
+}
+
+GroundTruth3D GroundTruthFromJson(const JsonCursor& cursor) {
+  GroundTruth3D truth;
+  std::string layout = cursor.Field("layout").String();
+  truth.layout = FindLayout(layout);
+  if (truth.layout == nullptr)
+    cursor.Field("layout").Fail("unknown layout '" + layout + "'");
+  JsonCursor frames = cursor.Field("keypoints_m");
+  size_t num_frames = frames.ArraySize();
+  for (size_t t = 0; t < num_frames; ++t) {
+    JsonCursor frame = frames.At(t);
+    frame.ArraySize(truth.layout->num_keypoints());
+    std::vector<Eigen::Vector3d> points;
+    for (int j = 0; j < truth.layout->num_keypoints(); ++j) {
+      points.push_back(Vector3FromJson(frame.At(j)));
+    }
+    truth.keypoints_m.push_back(points);
+  }
+  if (cursor.Has("poses")) {
+    truth.skeleton_name = cursor.Field("skeleton").String();
+    JsonCursor poses = cursor.Field("poses");
+    size_t count = poses.ArraySize(static_cast<long>(num_frames));
+    size_t num_joints = 0;
+    for (size_t t = 0; t < count; ++t) {
+      JsonCursor entry = poses.At(t);
+      Pose3D pose;
+      pose.root_position_m = Vector3FromJson(entry.Field("root_position_m"));
+      JsonCursor rotations = entry.Field("local_rotations_wxyz");
+      size_t joints =
+          rotations.ArraySize(t == 0 ? -1 : static_cast<long>(num_joints));
+      num_joints = joints;
+      for (size_t j = 0; j < joints; ++j) {
+        JsonCursor q = rotations.At(j);
+        q.ArraySize(4);
+        Eigen::Quaterniond rotation(q.At(0).Number(), q.At(1).Number(),
+                                    q.At(2).Number(), q.At(3).Number());
+        if (std::abs(rotation.norm() - 1.0) > 1e-3)
+          q.Fail("not a unit quaternion");
+        pose.local_rotations.push_back(rotation.normalized());
+      }
+      truth.poses.push_back(pose);
+    }
+  }
+  return truth;
+}
+
+}  // namespace
+
+void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
+  if (bundle.views.empty()) throw InputError(source, "bundle has no views");
+  if (!(bundle.fps > 0)) throw InputError(source, "fps must be positive");
+  const int num_frames = bundle.num_frames();
+  for (const ReferenceView& view : bundle.views) {
+    ValidateClip(view.clip, source + " (view " + view.name + ")");
+    if (view.clip.num_frames() != num_frames) {
+      throw InputError(source, "view " + view.name + " has " +
+                                   std::to_string(view.clip.num_frames()) +
+                                   " frames, the first view has " +
+                                   std::to_string(num_frames));
+    }
+    if (std::abs(view.clip.fps - bundle.fps) > 1e-9) {
+      throw InputError(source,
+                       "view " + view.name + " fps differs from the bundle's");
+    }
+    if (view.cameras.size() != 1 &&
+        static_cast<int>(view.cameras.size()) != num_frames) {
+      throw InputError(source, "view " + view.name + " has " +
+                                   std::to_string(view.cameras.size()) +
+                                   " cameras: need 1 or one per frame (" +
+                                   std::to_string(num_frames) + ")");
+    }
+  }
+  if (bundle.ground_truth) {
+    const GroundTruth3D& truth = *bundle.ground_truth;
+    if (static_cast<int>(truth.keypoints_m.size()) != num_frames) {
+      throw InputError(source, "ground truth has " +
+                                   std::to_string(truth.keypoints_m.size()) +
+                                   " frames, clips have " +
+                                   std::to_string(num_frames));
+    }
+    if (!truth.poses.empty() &&
+        static_cast<int>(truth.poses.size()) != num_frames) {
+      throw InputError(source,
+                       "ground-truth poses do not match the frame count");
+    }
+  }
+}
+
+ReferenceBundle ReadBundle(const std::string& path) {
+  nlohmann::json json = ReadJsonFile(path);
+  JsonCursor root(json, path);
+  if (root.Field("format").String() != kBundleFormat) {
+    root.Field("format").Fail(std::string("expected \"") + kBundleFormat +
+                              "\"");
+  }
+  if (root.Field("version").Integer() != kBundleVersion) {
+    root.Field("version").Fail("unsupported version");
+  }
+  ReferenceBundle bundle;
+  bundle.name = root.Field("name").String();
+  bundle.fps = root.Field("fps").Number();
+  JsonCursor views = root.Field("views");
+  size_t num_views = views.ArraySize();
+  for (size_t k = 0; k < num_views; ++k) {
+    JsonCursor entry = views.At(k);
+    ReferenceView view;
+    view.name = entry.Field("name").String();
+    JsonCursor cameras = entry.Field("cameras");
+    size_t num_cameras = cameras.ArraySize();
+    for (size_t i = 0; i < num_cameras; ++i) {
+      view.cameras.push_back(CameraFromJson(cameras.At(i)));
+    }
+    view.clip = ClipFromJson(entry.Field("clip"));
+    bundle.views.push_back(std::move(view));
+  }
+  if (root.Has("ground_truth")) {
+    bundle.ground_truth = GroundTruthFromJson(root.Field("ground_truth"));
+  }
+  ValidateBundle(bundle, path);
+  return bundle;
+}
+
+void WriteBundle(const std::string& path, const ReferenceBundle& bundle) {
+  ValidateBundle(bundle, path);
+  nlohmann::json views = nlohmann::json::array();
+  for (const ReferenceView& view : bundle.views) {
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const PinholeCamera& camera : view.cameras) {
+      cameras.push_back(CameraToJson(camera));
+    }
+    views.push_back({{"name", view.name},
+                     {"cameras", cameras},
+                     {"clip", ClipToJson(view.clip)}});
+  }
+  nlohmann::json json = {{"format", kBundleFormat},
+                         {"version", kBundleVersion},
+                         {"name", bundle.name},
+                         {"fps", bundle.fps},
+                         {"views", views}};
+  if (bundle.ground_truth)
+    json["ground_truth"] = GroundTruthToJson(*bundle.ground_truth);
+  WriteJsonFileAtomic(path, json);
+}
+
+void DetectorNoiseOptions::Validate() const {
+  if (!(pixel_sigma_px >= 0))
+    throw ConfigError("noise: pixel_sigma_px must be >= 0");
+  if (!(drop_probability >= 0 && drop_probability < 1)) {
+    throw ConfigError("noise: drop_probability must be in [0, 1)");
+  }
+  if (!(time_jitter_frames >= 0)) {
+    throw ConfigError("noise: time_jitter_frames must be >= 0");
+  }
+}
+
+void BundleFromMotionOptions::Validate() const {
+  if (!(fps > 0 && fps <= 1000))
+    throw ConfigError("bundle: fps must be in (0, 1000]");
+  if (!(duration_s >= 0)) throw ConfigError("bundle: duration_s must be >= 0");
+  if (!(follow_smoothing_s >= 0)) {
+    throw ConfigError("bundle: follow_smoothing_s must be >= 0");
+  }
+  rig.Validate();
+  noise.Validate();
+}
+
+namespace {
+
+// Keypoints of every frame at a fractional frame index (linear blend).
+std::vector<Eigen::Vector3d> BlendFrames(
+    const std::vector<std::vector<Eigen::Vector3d>>& frames, double index) {
+  double clamped =
+      std::clamp(index, 0.0, static_cast<double>(frames.size() - 1));
+  size_t lower = static_cast<size_t>(std::floor(clamped));
+  size_t upper = std::min(lower + 1, frames.size() - 1);
+  double alpha = clamped - lower;
+  std::vector<Eigen::Vector3d> out(frames[lower].size());
+  for (size_t j = 0; j < out.size(); ++j) {
+    out[j] = (1 - alpha) * frames[lower][j] + alpha * frames[upper][j];
+  }
+  return out;
+}
+
+// The subject's ground path (root x, y), averaged over a centred window.
+std::vector<Eigen::Vector3d> SmoothedGroundPath(
+    const std::vector<Pose3D>& poses, int half_window) {
+  std::vector<Eigen::Vector3d> path(poses.size());
+  const int count = static_cast<int>(poses.size());
+  for (int t = 0; t < count; ++t) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int used = 0;
+    for (int s = std::max(0, t - half_window);
+         s <= std::min(count - 1, t + half_window); ++s, ++used) {
+      sum += poses[s].root_position_m;
+    }
+    path[t] = sum / used;
+    path[t].z() = 0.0;
+  }
+  return path;
+}
+
+}  // namespace
+
+ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
+                                     const KeypointMap& keypoint_map,
+                                     const BundleFromMotionOptions& options,
+                                     const std::string& name) {
+  // Outline: loop/resample the motion to the clip rate, run FK for the 3D
+  // keypoints, place the rig at the start root, project per view (moving
+  // the camera with the subject when following), add detector noise.
+  options.Validate();
+  Motion3D sampled = ExtendLoop(motion, options.duration_s);
+  sampled = ResampleMotion(sampled, options.fps);
+  if (options.duration_s > 0) {
+    int wanted =
+        static_cast<int>(std::floor(options.duration_s * options.fps + 1e-9)) +
+        1;
+    if (wanted < sampled.num_frames()) sampled.frames.resize(wanted);
+  }
+  if (sampled.num_frames() < 1) throw InputError(name, "motion has no frames");
+
+  ReferenceBundle bundle;
+  bundle.name = name;
+  bundle.fps = options.fps;
+  GroundTruth3D truth;
+  truth.layout = keypoint_map.layout;
+  truth.skeleton_name = motion.skeleton->name;
+  for (const Pose3D& pose : sampled.frames) {
+    truth.keypoints_m.push_back(
+        KeypointPositions(*motion.skeleton, keypoint_map, pose));
+  }
+  truth.poses = sampled.frames;
+
+  RigOptions rig = options.rig;
+  Eigen::Vector3d start = sampled.frames.front().root_position_m;
+  rig.target_m += Eigen::Vector3d(start.x(), start.y(), 0.0);
+  std::vector<NamedCamera> base_cameras = MakeRig(rig);
+  std::vector<Eigen::Vector3d> path;
+  if (options.follow == CameraFollow::kRootDolly) {
+    int half_window = static_cast<int>(
+        std::round(0.5 * options.follow_smoothing_s * options.fps));
+    path = SmoothedGroundPath(sampled.frames, half_window);
+  }
+
+  std::mt19937_64 rng(options.noise.seed);
+  std::normal_distribution<double> unit_normal(0.0, 1.0);
+  std::uniform_real_distribution<double> unit_uniform(0.0, 1.0);
+  const int num_frames = sampled.num_frames();
+  const int num_keypoints = keypoint_map.layout->num_keypoints();
+  for (const NamedCamera& base : base_cameras) {
+    ReferenceView view;
+    view.name = base.name;
+    if (path.empty()) {
+      view.cameras = {base.camera};
+    } else {
+      for (int t = 0; t < num_frames; ++t) {
+        view.cameras.push_back(base.camera.Translated(path[t] - path[0]));
+      }
+    }
+    view.clip.layout = keypoint_map.layout;
+    view.clip.fps = options.fps;
+    view.clip.image_width_px = rig.width_px;
+    view.clip.image_height_px = rig.height_px;
+    view.clip.keypoints = KeypointTrack(num_frames, num_keypoints);
+    for (int t = 0; t < num_frames; ++t) {
+      const PinholeCamera& camera = view.CameraAt(t);
+      std::vector<Eigen::Vector3d> points =
+          options.noise.time_jitter_frames > 0
+              ? BlendFrames(
+                    truth.keypoints_m,
+                    t + options.noise.time_jitter_frames * unit_normal(rng))
+              : truth.keypoints_m[t];
+      for (int j = 0; j < num_keypoints; ++j) {
+        Projection projection = camera.Project(points[j]);
+        Keypoint2D& keypoint = view.clip.keypoints.at(t, j);
+        keypoint.x_px = projection.pixel_px.x();
+        keypoint.y_px = projection.pixel_px.y();
+        keypoint.confidence = projection.in_front ? 1.0 : 0.0;
+        if (options.noise.pixel_sigma_px > 0) {
+          keypoint.x_px += options.noise.pixel_sigma_px * unit_normal(rng);
+          keypoint.y_px += options.noise.pixel_sigma_px * unit_normal(rng);
+        }
+        if (options.noise.drop_probability > 0 &&
+            unit_uniform(rng) < options.noise.drop_probability) {
+          keypoint = Keypoint2D{std::nan(""), std::nan(""), 0.0};
+        }
+      }
+    }
+    bundle.views.push_back(std::move(view));
+  }
+  bundle.ground_truth = std::move(truth);
+  ValidateBundle(bundle, name);
+  return bundle;
+}
+
+std::vector<ViewSummary> SummarizeBundle(const ReferenceBundle& bundle) {
+  std::vector<ViewSummary> summaries;
+  for (const ReferenceView& view : bundle.views) {
+    ViewSummary summary;
+    summary.name = view.name;
+    summary.num_frames = view.clip.num_frames();
+    long present = 0, inside = 0, total = 0;
+    double height_sum = 0.0;
+    int height_frames = 0;
+    for (int t = 0; t < view.clip.num_frames(); ++t) {
+      double top = INFINITY, bottom = -INFINITY;
+      for (int j = 0; j < view.clip.keypoints.num_keypoints(); ++j) {
+        const Keypoint2D& k = view.clip.keypoints.at(t, j);
+        ++total;
+        if (!k.IsPresent()) continue;
+        ++present;
+        if (k.x_px >= 0 && k.y_px >= 0 && k.x_px < view.clip.image_width_px &&
+            k.y_px < view.clip.image_height_px) {
+          ++inside;
+        }
+        top = std::min(top, k.y_px);
+        bottom = std::max(bottom, k.y_px);
+      }
+      if (bottom > top) {
+        height_sum += bottom - top;
+        ++height_frames;
+      }
+    }
+    summary.present_fraction =
+        total ? static_cast<double>(present) / total : 0.0;
+    summary.in_image_fraction =
+        present ? static_cast<double>(inside) / present : 0.0;
+    summary.mean_height_px = height_frames ? height_sum / height_frames : 0.0;
+    summaries.push_back(summary);
+  }
+  return summaries;
+}
+
+}  // namespace m2d

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Runs every test: builds if needed, runs the GoogleTest suites through ctest,
+# then a quick smoke pass of the benchmarks.
+set -euo pipefail
+cd "$(dirname "$0")"
+[ -d build ] || ./setup.sh --no-demo
+cmake --build build -j"$(nproc)"
+ctest --test-dir build --output-on-failure -j"$(nproc)"
+if [ -x build/m2d_bench ]; then
+  echo "== benchmark smoke pass"
+  build/m2d_bench --benchmark_min_time=0.01 > build/bench_smoke.txt 2>&1 \
+    || { cat build/bench_smoke.txt; exit 1; }
+  tail -n 5 build/bench_smoke.txt
+fi
