@@ -10,7 +10,8 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libmujoco-dev libtorch-dev libceres-dev libassimp-dev assimp-testmodels
+  # libqhull-dev: mujoco's CMake target names /usr/include/libqhull_r
+  libmujoco-dev libqhull-dev libtorch-dev libceres-dev libassimp-dev assimp-testmodels
   libosmesa6-dev ffmpeg gnuplot-nox
 )
 
