@@ -7,34 +7,6 @@
 namespace m2d {
 namespace {
 
-// Per-frame roots and scales with gaps filled: forward from the previous
-// usable frame, and backward from the first usable one for a leading gap.
-void FrameRootsAndScales(const Clip2D& clip, const std::string& source,
-                         std::vector<Eigen::Vector2d>* roots,
-                         std::vector<double>* scales) {
-  const int num_frames = clip.num_frames();
-  std::vector<bool> usable(num_frames, false);
-  roots->assign(num_frames, Eigen::Vector2d::Zero());
-  scales->assign(num_frames, 0.0);
-  int first_usable = -1;
-  for (int t = 0; t < num_frames; ++t) {
-    usable[t] = RootAndScale(clip.keypoints.frame(t), *clip.layout,
-                             &(*roots)[t], &(*scales)[t]);
-    if (usable[t] && first_usable < 0) first_usable = t;
-  }
-  if (first_usable < 0) {
-    throw InputError(source,
-                     "no frame has a root keypoint and 2 present keypoints; "
-                     "cannot build the canonical representation");
-  }
-  for (int t = 0; t < num_frames; ++t) {
-    if (usable[t]) continue;
-    const int from = t < first_usable ? first_usable : t - 1;
-    (*roots)[t] = (*roots)[from];
-    (*scales)[t] = (*scales)[from];
-  }
-}
-
 Keypoint2D ToLocal(const Keypoint2D& point, const Eigen::Vector2d& root,
                    double scale) {
   return {(point.x_px - root.x()) / scale, (point.y_px - root.y()) / scale,
@@ -72,6 +44,32 @@ void CheckCanonicalShapes(const CanonicalClip& canonical) {
 }
 
 }  // namespace
+
+void FrameRootsAndScales(const Clip2D& clip, const std::string& source,
+                         std::vector<Eigen::Vector2d>* roots,
+                         std::vector<double>* scales) {
+  const int num_frames = clip.num_frames();
+  std::vector<bool> usable(num_frames, false);
+  roots->assign(num_frames, Eigen::Vector2d::Zero());
+  scales->assign(num_frames, 0.0);
+  int first_usable = -1;
+  for (int t = 0; t < num_frames; ++t) {
+    usable[t] = RootAndScale(clip.keypoints.frame(t), *clip.layout,
+                             &(*roots)[t], &(*scales)[t]);
+    if (usable[t] && first_usable < 0) first_usable = t;
+  }
+  if (first_usable < 0) {
+    throw InputError(source,
+                     "no frame has a root keypoint and 2 present keypoints; "
+                     "cannot build the canonical representation");
+  }
+  for (int t = 0; t < num_frames; ++t) {
+    if (usable[t]) continue;
+    const int from = t < first_usable ? first_usable : t - 1;
+    (*roots)[t] = (*roots)[from];
+    (*scales)[t] = (*scales)[from];
+  }
+}
 
 bool RootAndScale(const Keypoint2D* frame, const KeypointLayout& layout,
                   Eigen::Vector2d* root, double* scale) {

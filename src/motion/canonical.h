@@ -27,6 +27,13 @@ inline constexpr double kMinCanonicalScalePx = 1e-6;
 bool RootAndScale(const Keypoint2D* frame, const KeypointLayout& layout,
                   Eigen::Vector2d* root, double* scale);
 
+// Per-frame roots and scales of a clip with gaps filled: forward from the
+// previous usable frame, and backward from the first usable one for a
+// leading gap. Throws InputError (naming `source`) when no frame is usable.
+void FrameRootsAndScales(const Clip2D& clip, const std::string& source,
+                         std::vector<Eigen::Vector2d>* roots,
+                         std::vector<double>* scales);
+
 // X^can: frame t holds local_pose_t, delta_root[t] = (root_t − root_{t−1})
 // / s_t and delta_log_scale[t] = log(s_t / s_{t−1}); both are 0 at t = 0,
 // whose root and scale are stored absolutely.
