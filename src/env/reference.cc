@@ -1,0 +1,207 @@
+#include "env/reference.h"
+
+#include <cmath>
+
+#include "common/error.h"
+#include "motion/canonical.h"
+#include "sim/pose_mapping.h"
+
+namespace m2d {
+namespace {
+
+// Mean of the layout's root keypoints and RMS spread of all keypoints, in
+// metres, for 3D keypoints (the 3D analogue of RootAndScale).
+void RootAndScale3D(const std::vector<Eigen::Vector3d>& keypoints,
+                    const KeypointLayout& layout, Eigen::Vector3d* root,
+                    double* scale_m) {
+  *root = Eigen::Vector3d::Zero();
+  for (int index : layout.root_keypoints) *root += keypoints[index];
+  *root /= static_cast<double>(layout.root_keypoints.size());
+  double squared = 0.0;
+  for (const Eigen::Vector3d& point : keypoints)
+    squared += (point - *root).squaredNorm();
+  *scale_m = std::sqrt(squared / keypoints.size());
+}
+
+std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
+  int count = simulation.character().keypoint_layout().num_keypoints();
+  std::vector<double> xyz(3 * count);
+  simulation.KeypointPositions(xyz.data());
+  std::vector<Eigen::Vector3d> points(count);
+  for (int j = 0; j < count; ++j)
+    points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
+  return points;
+}
+
+// The model's default pose, turned to face the camera and moved so that its
+// root keypoints project onto the 2D root, at the height they have standing.
+Pose3D PlaceDefaultPose(const Character& character, const Pose3D& standing,
+                        const std::vector<Eigen::Vector3d>& standing_keypoints,
+                        const PinholeCamera& camera,
+                        const ImageNormalization& image) {
+  Eigen::Vector3d root3d;
+  double scale_m;
+  RootAndScale3D(standing_keypoints, character.keypoint_layout(), &root3d,
+                 &scale_m);
+  // The ray through the 2D root, in world coordinates.
+  const Intrinsics& k = camera.intrinsics();
+  Eigen::Vector3d direction_camera((image.root_px.x() - k.cx_px) / k.fx_px,
+                                   (image.root_px.y() - k.cy_px) / k.fy_px,
+                                   1.0);
+  Eigen::Vector3d direction =
+      camera.rotation_world_to_camera().transpose() * direction_camera;
+  Eigen::Vector3d centre = camera.CenterWorld();
+  // Meet the plane at the standing root height; for a ray nearly parallel to
+  // the floor, use the depth at which the 3D spread has the 2D scale.
+  double depth_along = 0.0;
+  if (std::abs(direction.z()) > 1e-3)
+    depth_along = (root3d.z() - centre.z()) / direction.z();
+  if (!(depth_along > 0)) depth_along = k.fx_px * scale_m / image.scale_px;
+  Eigen::Vector3d target = centre + depth_along * direction;
+
+  Pose3D pose = standing;
+  Eigen::Vector3d to_camera = centre - target;
+  double yaw = std::atan2(to_camera.y(), to_camera.x());
+  Eigen::Quaterniond turn(
+      Eigen::AngleAxisd(yaw - HeadingAngle(standing.local_rotations[0]),
+                        Eigen::Vector3d::UnitZ()));
+  pose.local_rotations[0] = turn * standing.local_rotations[0];
+  Eigen::Vector3d root_offset = turn * (root3d - standing.root_position_m);
+  pose.root_position_m = target - root_offset;
+  pose.root_position_m.z() = standing.root_position_m.z();
+  return pose;
+}
+
+}  // namespace
+
+std::shared_ptr<const TrackingReference> TrackingReference::Prepare(
+    std::vector<ReferenceBundle> bundles, const Character& character,
+    double control_hz) {
+  auto reference = std::shared_ptr<TrackingReference>(new TrackingReference());
+  if (bundles.empty()) throw InputError("", "no reference bundles to track");
+  const KeypointLayout& layout = character.keypoint_layout();
+  const std::vector<FreeObject>& objects = character.free_objects();
+
+  // Object points: the first bundle's object tracks, each naming one of the
+  // scene's free objects; every bundle must track the same ones.
+  const Clip2D& first_clip = bundles[0].views[0].clip;
+  for (const ObjectTrack2D& track : first_clip.objects) {
+    int body = -1;
+    for (const FreeObject& object : objects) {
+      if (object.name == track.name) body = object.body_id;
+    }
+    if (body < 0) {
+      throw InputError(bundles[0].name,
+                       "object track '" + track.name +
+                           "' has no free body of that name in the scene");
+    }
+    reference->object_bodies_.push_back(body);
+  }
+  reference->num_object_points_ = static_cast<int>(first_clip.objects.size());
+  reference->num_points_ =
+      layout.num_keypoints() + reference->num_object_points_;
+
+  for (size_t b = 0; b < bundles.size(); ++b) {
+    const ReferenceBundle& bundle = bundles[b];
+    if (std::abs(bundle.fps - control_hz) > 1e-6) {
+      throw InputError(bundle.name,
+                       "bundle is at " + std::to_string(bundle.fps) +
+                           " fps but the controller runs at " +
+                           std::to_string(control_hz) +
+                           " Hz: make the bundle at the control rate");
+    }
+    if (bundle.num_frames() < 2)
+      throw InputError(bundle.name, "needs at least 2 frames");
+    for (size_t v = 0; v < bundle.views.size(); ++v) {
+      const Clip2D& clip = bundle.views[v].clip;
+      std::string where = bundle.name + " view " + bundle.views[v].name;
+      if (clip.layout != &layout) {
+        throw InputError(where, "layout " + clip.layout->name +
+                                    " differs from the character's " +
+                                    layout.name);
+      }
+      if (clip.objects.size() != first_clip.objects.size()) {
+        throw InputError(
+            where, "tracks a different set of objects than the first bundle");
+      }
+      TrackedView view;
+      view.bundle = static_cast<int>(b);
+      view.view = static_cast<int>(v);
+      view.num_frames = clip.num_frames();
+      view.num_points = reference->num_points_;
+      view.points.reserve(static_cast<size_t>(view.num_frames) *
+                          view.num_points);
+      for (int t = 0; t < view.num_frames; ++t) {
+        for (int j = 0; j < layout.num_keypoints(); ++j)
+          view.points.push_back(clip.keypoints.at(t, j));
+        for (size_t o = 0; o < clip.objects.size(); ++o) {
+          if (clip.objects[o].name != first_clip.objects[o].name) {
+            throw InputError(where, "object " + std::to_string(o) + " is '" +
+                                        clip.objects[o].name + "', expected '" +
+                                        first_clip.objects[o].name + "'");
+          }
+          view.points.push_back(clip.objects[o].points[t]);
+        }
+      }
+      std::vector<Eigen::Vector2d> roots;
+      std::vector<double> scales;
+      FrameRootsAndScales(clip, where, &roots, &scales);
+      for (int t = 0; t < view.num_frames; ++t)
+        view.normalization.push_back({roots[t], scales[t]});
+      reference->views_.push_back(std::move(view));
+    }
+  }
+  reference->bundles_ = std::move(bundles);
+  return reference;
+}
+
+InitialStates::InitialStates(const TrackingReference& reference,
+                             std::shared_ptr<const Character> character,
+                             const SimulationOptions& simulation_options,
+                             const StateBufferOptions& options) {
+  // Outline: per bundle, per frame, put the character in a plausible pose
+  // (3D truth when known, else a placed default pose) and keep the state.
+  Simulation simulation(character, simulation_options);
+  const double dt_s = 1.0 / simulation_options.control_hz;
+  simulation.Reset();
+  Pose3D standing = QposToPose(*character, simulation.data()->qpos);
+  std::vector<Eigen::Vector3d> standing_keypoints =
+      SimulatedKeypoints(simulation);
+  std::vector<double> qvel(character->model()->nv, 0.0);
+
+  for (const ReferenceBundle& bundle : reference.bundles()) {
+    StateBuffer buffer(bundle.num_frames(), options);
+    const bool has_poses =
+        bundle.ground_truth && !bundle.ground_truth->poses.empty() &&
+        bundle.ground_truth->skeleton_name == character->skeleton().name;
+    // The default-pose fallback places the character from the first view.
+    const TrackedView* first_view = nullptr;
+    for (const TrackedView& view : reference.views()) {
+      if (&reference.bundles()[view.bundle] == &bundle) {
+        first_view = &view;
+        break;
+      }
+    }
+    for (int t = 0; t < bundle.num_frames(); ++t) {
+      simulation.Reset();
+      if (has_poses) {
+        const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
+        int next = std::min(t + 1, bundle.num_frames() - 1);
+        int previous = next == t ? t - 1 : t;
+        std::fill(qvel.begin(), qvel.end(), 0.0);
+        QvelFromPoses(*character, poses[previous], poses[next], dt_s,
+                      qvel.data());
+        simulation.SetPose(poses[t], qvel.data());
+      } else {
+        simulation.SetPose(
+            PlaceDefaultPose(*character, standing, standing_keypoints,
+                             bundle.views[first_view->view].CameraAt(t),
+                             first_view->normalization[t]));
+      }
+      buffer.Insert(t, simulation.Save(), 0.0);
+    }
+    buffers_.push_back(std::move(buffer));
+  }
+}
+
+}  // namespace m2d

@@ -1,0 +1,120 @@
+// env: the single-view 2D tracking environment. An episode draws a
+// (bundle, view) pair and a start frame, starts from that frame's
+// initial-state buffer, and rewards the character for projecting, through
+// the view's camera, onto the 2D reference. The camera is never observed.
+#ifndef MIMIC2D_ENV_TRACKING_ENV_H_
+#define MIMIC2D_ENV_TRACKING_ENV_H_
+
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "env/observation.h"
+#include "env/reference.h"
+#include "env/reward.h"
+#include "sim/simulation.h"
+
+namespace m2d {
+
+struct TrackingEnvOptions {
+  SimulationOptions simulation;
+  int num_future_frames = 5;               // L reference frames observed ahead
+  double max_episode_s = 10.0;             // episodes are truncated after this
+  bool early_exit = true;                  // reprojection early exit on/off
+  double early_exit_max_error_px = 100.0;  // worst-keypoint error that ends it
+  RewardWeights reward;
+  // "Noisy S.I.": Gaussian noise (rad) added to every hinge angle of an
+  // initial state drawn from the buffer; 0 disables.
+  double initial_state_noise_rad = 0.0;
+
+  int max_episode_steps() const {
+    return static_cast<int>(max_episode_s * simulation.control_hz + 0.5);
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// What one Step() did.
+struct StepOutcome {
+  float reward = 0.0f;
+  bool terminated = false;  // early exit or divergence: no bootstrap
+  bool truncated = false;   // time limit or end of reference: bootstrap
+  bool diverged = false;
+  ReprojectionError error;  // of the new frame
+  RewardTerms terms;
+};
+
+// Running statistics of the current episode (for logs and evaluation).
+struct EpisodeStats {
+  int view_index = 0;  // into TrackingReference::views()
+  int start_frame = 0;
+  int steps = 0;
+  double total_reward = 0.0;
+  double sum_mean_error_px = 0.0;  // sum over steps of the frame's mean
+  double max_error_px = 0.0;       // worst keypoint over the episode
+  bool failed = false;             // ended by early exit or divergence
+
+  double mean_error_px() const {
+    return steps ? sum_mean_error_px / steps : 0.0;
+  }
+};
+
+class TrackingEnv {
+ public:
+  TrackingEnv(std::shared_ptr<const Character> character,
+              std::shared_ptr<const TrackingReference> reference,
+              std::shared_ptr<const InitialStates> initial_states,
+              const TrackingEnvOptions& options, uint64_t seed);
+
+  const ObservationLayout& layout() const { return layout_; }
+  int observation_size() const { return layout_.size(); }
+  int action_size() const { return simulation_.character().num_actions(); }
+
+  // Starts an episode at a random view and frame; writes its observation.
+  void Reset(float* observation);
+  // Starts an episode at a given view and frame with a given state.
+  void ResetTo(int view_index, int frame, const SimState& state,
+               float* observation);
+  // Advances one control period. Writes the next observation unless the
+  // episode ended (the caller resets).
+  StepOutcome Step(const float* action, float* observation);
+
+  const EpisodeStats& episode() const { return episode_; }
+  int frame() const { return frame_; }
+  const TrackedView& view() const { return *view_; }
+  const Simulation& simulation() const { return simulation_; }
+  Simulation& mutable_simulation() { return simulation_; }
+  // The simulated keypoints projected by the episode's camera at the
+  // current frame (x, y per point; valid after Reset/Step).
+  const std::vector<double>& projected_px() const { return projected_xy_; }
+  // Current observation written again (e.g. after the trainer edits state).
+  void WriteObservation(float* observation);
+
+ private:
+  void BeginEpisode(int view_index, int frame);
+  void ProjectCurrentPoints();
+  void ReadBodyKinematics();
+
+  std::shared_ptr<const TrackingReference> reference_;
+  std::shared_ptr<const InitialStates> initial_states_;
+  TrackingEnvOptions options_;
+  Simulation simulation_;
+  ObservationLayout layout_;
+  std::mt19937_64 rng_;
+
+  const TrackedView* view_ = nullptr;
+  int frame_ = 0;
+  EpisodeStats episode_;
+
+  // Scratch buffers, sized once.
+  BodyKinematics bodies_;
+  std::vector<double> keypoints_xyz_;
+  std::vector<double> projected_xy_;
+  std::unique_ptr<bool[]> in_front_;
+  std::vector<Keypoint2D> projected_points_;
+  std::vector<Eigen::Vector3d> object_positions_, object_velocities_;
+};
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_ENV_TRACKING_ENV_H_

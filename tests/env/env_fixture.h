@@ -1,0 +1,59 @@
+// tests: a humanoid tracking a multi-view walk bundle (shared data).
+#ifndef MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_
+#define MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_
+
+#include <memory>
+#include <string>
+
+#include "env/reference.h"
+#include "env/tracking_env.h"
+#include "motion/bundle.h"
+#include "motion/motion_io.h"
+#include "sim/simulation.h"
+#include "test_paths.h"
+
+namespace m2d::testing {
+
+struct WalkTask {
+  std::shared_ptr<const Character> character;
+  std::shared_ptr<const TrackingReference> reference;
+  std::shared_ptr<InitialStates> initial_states;
+  TrackingEnvOptions options;
+};
+
+inline std::shared_ptr<const Character> LoadHumanoid(
+    const SimulationOptions& options) {
+  return LoadCharacterForSimulation(
+      SourcePath("assets/characters/humanoid.yaml"), "flat", options);
+}
+
+// The DeepMimic walk looped to `duration_s`, seen by 4 cameras that follow.
+inline ReferenceBundle MakeWalkBundle(const std::string& motion_path,
+                                      const Character& character,
+                                      double duration_s = 4.0) {
+  Motion3D motion =
+      ReadDeepMimicMotion(motion_path, character.shared_skeleton());
+  BundleFromMotionOptions options;
+  options.duration_s = duration_s;
+  options.follow = CameraFollow::kRootDolly;
+  return MakeBundleFromMotion(motion, character.keypoint_map(), options,
+                              "walk");
+}
+
+inline WalkTask MakeWalkTask(const std::string& motion_path,
+                             double duration_s = 4.0) {
+  WalkTask task;
+  task.character = LoadHumanoid(task.options.simulation);
+  std::vector<ReferenceBundle> bundles;
+  bundles.push_back(MakeWalkBundle(motion_path, *task.character, duration_s));
+  task.reference = TrackingReference::Prepare(
+      std::move(bundles), *task.character, task.options.simulation.control_hz);
+  task.initial_states = std::make_shared<InitialStates>(
+      *task.reference, task.character, task.options.simulation,
+      StateBufferOptions());
+  return task;
+}
+
+}  // namespace m2d::testing
+
+#endif  // MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_
