@@ -1,0 +1,39 @@
+#include "common/yaml_fields.h"
+
+namespace m2d {
+
+YamlSection::YamlSection(YAML::Node node, std::string source, std::string where)
+    : node_(node), source_(std::move(source)), where_(std::move(where)) {
+  if (node_ && !node_.IsNull() && !node_.IsMap()) {
+    throw InputError(source_, (where_.empty() ? "top level" : where_) +
+                                  ": expected a mapping of settings");
+  }
+}
+
+YAML::Node YamlSection::Child(const std::string& key) {
+  read_keys_.insert(key);
+  if (!node_ || !node_.IsMap()) return YAML::Node();
+  return node_[key];
+}
+
+bool YamlSection::Has(const std::string& key) const {
+  return node_ && node_.IsMap() && node_[key];
+}
+
+YamlSection YamlSection::Section(const std::string& key) {
+  return YamlSection(Child(key), source_, where_.empty() ? key : where_ + "." + key);
+}
+
+void YamlSection::RejectUnknownKeys() const {
+  if (!node_ || !node_.IsMap()) return;
+  for (const auto& entry : node_) {
+    std::string key = entry.first.as<std::string>();
+    if (read_keys_.count(key) == 0) Fail(key, "is not a known setting");
+  }
+}
+
+void YamlSection::Fail(const std::string& key, const std::string& problem) const {
+  throw InputError(source_, "'" + (where_.empty() ? key : where_ + "." + key) + "' " + problem);
+}
+
+}  // namespace m2d
