@@ -14,6 +14,12 @@ using CommandRun = std::function<int()>;
 // Each registers its subcommand on `app` and stores its body in `*run`.
 void AddClipCommand(CLI::App& app, CommandRun* run);
 void AddDemoCommand(CLI::App& app, CommandRun* run);
+void AddRenderCommand(CLI::App& app, CommandRun* run);
+void AddPlotCommand(CLI::App& app, CommandRun* run);
+void AddReportCommand(CLI::App& app, CommandRun* run);
+void AddTrainCommand(CLI::App& app, CommandRun* run);
+void AddEvalCommand(CLI::App& app, CommandRun* run);
+void AddBenchCommand(CLI::App& app, CommandRun* run);
 
 // Where assets/ lives: $MIMIC2D_ASSETS, else the source tree's assets/.
 std::string AssetPath(const std::string& relative);

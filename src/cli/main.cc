@@ -27,6 +27,12 @@ int main(int argc, char** argv) {
   m2d::cli::CommandRun run;
   m2d::cli::AddClipCommand(app, &run);
   m2d::cli::AddDemoCommand(app, &run);
+  m2d::cli::AddRenderCommand(app, &run);
+  m2d::cli::AddPlotCommand(app, &run);
+  m2d::cli::AddReportCommand(app, &run);
+  m2d::cli::AddTrainCommand(app, &run);
+  m2d::cli::AddEvalCommand(app, &run);
+  m2d::cli::AddBenchCommand(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -34,6 +34,7 @@ class StateBuffer {
   StateBuffer(int num_frames, const StateBufferOptions& options);
 
   int num_frames() const { return static_cast<int>(entries_.size()); }
+  const StateBufferOptions& options() const { return options_; }
   int size(int frame) const { return static_cast<int>(entries_[frame].size()); }
   const ScoredState& entry(int frame, int index) const {
     return entries_[frame][index];

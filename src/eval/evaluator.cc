@@ -1,0 +1,174 @@
+#include "eval/evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+#include "eval/metrics.h"
+
+namespace m2d {
+namespace {
+
+std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
+  const int count = simulation.character().keypoint_layout().num_keypoints();
+  std::vector<double> xyz(3 * count);
+  simulation.KeypointPositions(xyz.data());
+  std::vector<Eigen::Vector3d> points(count);
+  for (int j = 0; j < count; ++j)
+    points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
+  return points;
+}
+
+int BestEntry(const StateBuffer& buffer, int frame) {
+  int best = 0;
+  for (int i = 1; i < buffer.size(frame); ++i) {
+    if (buffer.entry(frame, i).score > buffer.entry(frame, best).score)
+      best = i;
+  }
+  return best;
+}
+
+}  // namespace
+
+void EvalOptions::Validate() const {
+  if (episodes_per_view < 1)
+    throw ConfigError("eval: episodes_per_view must be >= 1");
+  if (!(episode_s > 0)) throw ConfigError("eval: episode_s must be > 0");
+  if (!(success_threshold_px > 0))
+    throw ConfigError("eval: success_threshold_px must be > 0");
+}
+
+std::vector<EvalRow> EvaluatePolicy(
+    Policy& policy, std::shared_ptr<const Character> character,
+    std::shared_ptr<const TrackingReference> reference,
+    std::shared_ptr<const InitialStates> initial_states,
+    const TrackingEnvOptions& env_options, const EvalOptions& options) {
+  options.Validate();
+  // The evaluation episode: early exit exactly at the success threshold, no
+  // initial-state noise.
+  TrackingEnvOptions eval_env = env_options;
+  eval_env.early_exit = true;
+  eval_env.early_exit_max_error_px = options.success_threshold_px;
+  eval_env.initial_state_noise_rad = 0.0;
+  eval_env.max_episode_s = options.episode_s;
+  TrackingEnv env(character, reference, initial_states, eval_env, 0);
+  if (env.observation_size() != policy.observation_size() ||
+      env.action_size() != policy.action_size()) {
+    throw InputError("policy", "expects " +
+                                   std::to_string(policy.observation_size()) +
+                                   " observations and " +
+                                   std::to_string(policy.action_size()) +
+                                   " actions; the environment has " +
+                                   std::to_string(env.observation_size()) +
+                                   " and " + std::to_string(env.action_size()));
+  }
+  std::vector<float> observation(env.observation_size()),
+      action(env.action_size());
+  const int episode_frames = eval_env.max_episode_steps();
+  const KeypointLayout& layout = character->keypoint_layout();
+  std::vector<EvalRow> rows;
+
+  for (size_t v = 0; v < reference->views().size(); ++v) {
+    const TrackedView& view = reference->views()[v];
+    const ReferenceBundle& bundle = reference->bundles()[view.bundle];
+    const bool has_truth = bundle.ground_truth.has_value();
+    EvalRow row;
+    row.bundle = bundle.name;
+    row.view = bundle.views[view.view].name;
+    double succ = 0, e2d = 0, eo2d = 0, e3d = 0, e3d_root = 0, jitter = 0,
+           frames = 0;
+    const int last_start = std::max(0, view.num_frames - 1 - episode_frames);
+    for (int e = 0; e < options.episodes_per_view; ++e) {
+      int start = options.episodes_per_view == 1
+                      ? 0
+                      : last_start * e / (options.episodes_per_view - 1);
+      const StateBuffer& buffer = initial_states->buffer(view.bundle);
+      env.ResetTo(static_cast<int>(v), start,
+                  buffer.entry(start, BestEntry(buffer, start)).state,
+                  observation.data());
+      KeypointFrames simulated, truth;
+      double object_error = 0.0;
+      int object_frames = 0;
+      for (;;) {
+        policy.Act(observation.data(), 1, action.data());
+        StepOutcome outcome = env.Step(action.data(), observation.data());
+        if (!outcome.diverged) {
+          simulated.push_back(SimulatedKeypoints(env.simulation()));
+          if (has_truth)
+            truth.push_back(bundle.ground_truth->keypoints_m[env.frame()]);
+        }
+        if (reference->num_object_points() > 0 && !outcome.diverged) {
+          const int num_keypoints = layout.num_keypoints();
+          double sum = 0;
+          int present = 0;
+          for (int o = 0; o < reference->num_object_points(); ++o) {
+            const Keypoint2D& target =
+                view.frame(env.frame())[num_keypoints + o];
+            if (!target.IsPresent()) continue;
+            const double* xy =
+                env.projected_px().data() + 2 * (num_keypoints + o);
+            sum += std::hypot(xy[0] - target.x_px, xy[1] - target.y_px);
+            ++present;
+          }
+          if (present > 0) {
+            object_error += sum / present;
+            ++object_frames;
+          }
+        }
+        if (outcome.terminated || outcome.truncated) break;
+      }
+      const EpisodeStats& stats = env.episode();
+      succ += stats.failed ? 0.0 : 1.0;
+      e2d += stats.mean_error_px();
+      frames += stats.steps;
+      jitter += MeanJerk(simulated, eval_env.simulation.control_hz);
+      if (object_frames > 0) eo2d += object_error / object_frames;
+      if (has_truth) {
+        e3d += 1000.0 * MeanPositionError(simulated, truth);
+        e3d_root +=
+            1000.0 * RootRelativePositionError(simulated, truth, layout);
+      }
+    }
+    const double n = options.episodes_per_view;
+    row.episodes = options.episodes_per_view;
+    row.succ = succ / n;
+    row.e2d_px = e2d / n;
+    row.jitter = jitter / n;
+    row.mean_frames = frames / n;
+    if (reference->num_object_points() > 0) row.eo2d_px = eo2d / n;
+    if (has_truth) {
+      row.e3d_mm = e3d / n;
+      row.e3d_root_mm = e3d_root / n;
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+EvalRow AggregateRows(const std::vector<EvalRow>& rows) {
+  EvalRow all;
+  all.bundle = "all";
+  all.view = "all";
+  double weight = 0;
+  for (const EvalRow& row : rows) weight += row.episodes;
+  if (weight == 0) return all;
+  auto average = [&](double EvalRow::*field) {
+    double sum = 0;
+    for (const EvalRow& row : rows) {
+      if (row.*field < 0) return -1.0;
+      sum += row.*field * row.episodes;
+    }
+    return sum / weight;
+  };
+  all.episodes = static_cast<int>(weight);
+  all.succ = average(&EvalRow::succ);
+  all.e2d_px = average(&EvalRow::e2d_px);
+  all.eo2d_px = average(&EvalRow::eo2d_px);
+  all.e3d_mm = average(&EvalRow::e3d_mm);
+  all.e3d_root_mm = average(&EvalRow::e3d_root_mm);
+  all.jitter = average(&EvalRow::jitter);
+  all.mean_frames = average(&EvalRow::mean_frames);
+  return all;
+}
+
+}  // namespace m2d

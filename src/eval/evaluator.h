@@ -1,0 +1,51 @@
+// eval: rolls a policy out on every view of every bundle and reports the
+// paper's metrics per (bundle, view).
+#ifndef MIMIC2D_EVAL_EVALUATOR_H_
+#define MIMIC2D_EVAL_EVALUATOR_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "env/policy.h"
+#include "env/reference.h"
+#include "env/tracking_env.h"
+
+namespace m2d {
+
+struct EvalOptions {
+  int episodes_per_view = 4;            // start frames spread over the clip
+  double episode_s = 10.0;              // episode length (clip end cuts it)
+  double success_threshold_px = 100.0;  // a frame whose worst keypoint is off
+                                        // by more fails the rollout
+  void Validate() const;                // throws ConfigError
+};
+
+struct EvalRow {
+  std::string bundle;
+  std::string view;
+  int episodes = 0;
+  double succ = 0.0;          // fraction of successful rollouts
+  double e2d_px = 0.0;        // mean per-frame mean 2D error (until failure)
+  double eo2d_px = -1.0;      // objects' 2D error; -1 without objects
+  double e3d_mm = -1.0;       // global 3D keypoint error; -1 without truth
+  double e3d_root_mm = -1.0;  // root-relative 3D error; -1 without truth
+  double jitter = 0.0;        // 10^3 m/s^3
+  double mean_frames = 0.0;   // frames rolled out per episode
+};
+
+// Episodes start from each frame's best-scoring initial state, use the
+// policy's deterministic action, and end at the first failing frame, the
+// clip end, or episode_s.
+std::vector<EvalRow> EvaluatePolicy(
+    Policy& policy, std::shared_ptr<const Character> character,
+    std::shared_ptr<const TrackingReference> reference,
+    std::shared_ptr<const InitialStates> initial_states,
+    const TrackingEnvOptions& env_options, const EvalOptions& options);
+
+// Mean of the rows, weighted by episodes ("all" row).
+EvalRow AggregateRows(const std::vector<EvalRow>& rows);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_EVAL_EVALUATOR_H_

@@ -1,0 +1,32 @@
+// eval: the paper's metrics (Succ, E2D, EO2D, E3D, Jitter) as pure
+// functions, and the evaluation of a policy over reference bundles.
+#ifndef MIMIC2D_EVAL_METRICS_H_
+#define MIMIC2D_EVAL_METRICS_H_
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "motion/layout.h"
+
+namespace m2d {
+
+using KeypointFrames = std::vector<std::vector<Eigen::Vector3d>>;  // T x J
+
+// Mean over frames and keypoints of |x_sim - x_true| (metres).
+double MeanPositionError(const KeypointFrames& simulated,
+                         const KeypointFrames& truth);
+
+// The same after subtracting each frame's root (mean of the layout's root
+// keypoints) from both: pose error independent of global drift (metres).
+double RootRelativePositionError(const KeypointFrames& simulated,
+                                 const KeypointFrames& truth,
+                                 const KeypointLayout& layout);
+
+// Jitter: mean over frames and keypoints of the magnitude of the third
+// time derivative of positions (finite differences at `fps`), in units of
+// 10^3 m/s^3 as reported in the paper's tables. 0 for fewer than 4 frames.
+double MeanJerk(const KeypointFrames& positions, double fps);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_EVAL_METRICS_H_

@@ -1,0 +1,204 @@
+#include "rl/checkpoint.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "common/error.h"
+
+namespace m2d {
+namespace {
+
+// A SimState as one row of doubles, in a fixed field order; sizes come from
+// a template state of the same model.
+std::vector<std::vector<double> SimState::*> StateFields() {
+  return {
+      &SimState::qpos,           &SimState::qvel,      &SimState::act,
+      &SimState::qacc_warmstart, &SimState::ctrl,      &SimState::qfrc_applied,
+      &SimState::xfrc_applied,   &SimState::mocap_pos, &SimState::mocap_quat};
+}
+
+int64_t FlatStateSize(const SimState& state_template) {
+  int64_t size = 1;  // time
+  for (auto field : StateFields())
+    size += static_cast<int64_t>((state_template.*field).size());
+  return size;
+}
+
+void FlattenState(const SimState& state, double* out) {
+  *out++ = state.time_s;
+  for (auto field : StateFields()) {
+    const std::vector<double>& values = state.*field;
+    std::copy(values.begin(), values.end(), out);
+    out += values.size();
+  }
+}
+
+void UnflattenState(const double* in, const SimState& state_template,
+                    SimState* state) {
+  state->time_s = *in++;
+  for (auto field : StateFields()) {
+    size_t count = (state_template.*field).size();
+    (state->*field).assign(in, in + count);
+    in += count;
+  }
+}
+
+}  // namespace
+
+void SaveCheckpoint(const std::string& path, const TrainConfig& config,
+                    ActorCritic& model, torch::optim::Optimizer& optimizer,
+                    const CheckpointCounters& counters,
+                    const InitialStates* initial_states,
+                    const SimState& state_template) {
+  torch::serialize::OutputArchive archive;
+  archive.write("format", c10::IValue(std::string("mimic2d.checkpoint.v1")));
+  archive.write("config_yaml", c10::IValue(TrainConfigToYaml(config)));
+  const ObservationLayout& layout = model->layout();
+  archive.write("layout",
+                torch::tensor({static_cast<int64_t>(layout.num_bodies),
+                               static_cast<int64_t>(layout.num_objects),
+                               static_cast<int64_t>(layout.num_points),
+                               static_cast<int64_t>(layout.num_future_frames),
+                               static_cast<int64_t>(model->action_size())}));
+  archive.write("iteration",
+                torch::tensor(static_cast<int64_t>(counters.iteration)));
+  archive.write("samples", torch::tensor(counters.samples));
+  archive.write("wall_time_s",
+                torch::tensor(counters.wall_time_s, torch::kDouble));
+  torch::serialize::OutputArchive model_archive;
+  model->save(model_archive);
+  archive.write("model", model_archive);
+  torch::serialize::OutputArchive optimizer_archive;
+  optimizer.save(optimizer_archive);
+  archive.write("optimizer", optimizer_archive);
+
+  if (initial_states != nullptr) {
+    const int64_t width = FlatStateSize(state_template);
+    for (int b = 0; b < initial_states->num_bundles(); ++b) {
+      const StateBuffer& buffer = initial_states->buffer(b);
+      int64_t entries = 0;
+      for (int f = 0; f < buffer.num_frames(); ++f) entries += buffer.size(f);
+      torch::Tensor states = torch::zeros({entries, width}, torch::kDouble);
+      torch::Tensor scores = torch::zeros({entries}, torch::kDouble);
+      torch::Tensor frames = torch::zeros({entries}, torch::kLong);
+      int64_t row = 0;
+      for (int f = 0; f < buffer.num_frames(); ++f) {
+        for (int i = 0; i < buffer.size(f); ++i, ++row) {
+          FlattenState(buffer.entry(f, i).state,
+                       states[row].data_ptr<double>());
+          scores[row] = buffer.entry(f, i).score;
+          frames[row] = f;
+        }
+      }
+      std::string prefix = "asi_" + std::to_string(b) + "_";
+      archive.write(prefix + "states", states);
+      archive.write(prefix + "scores", scores);
+      archive.write(prefix + "frames", frames);
+    }
+  }
+
+  std::string temp = path + ".tmp." + std::to_string(::getpid());
+  archive.save_to(temp);
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    std::remove(temp.c_str());
+    throw InputError(path, "cannot write checkpoint");
+  }
+}
+
+namespace {
+
+torch::serialize::InputArchive OpenArchive(const std::string& path) {
+  torch::serialize::InputArchive archive;
+  try {
+    archive.load_from(path);
+  } catch (const c10::Error& e) {
+    throw InputError(path, "not a readable checkpoint (" +
+                               std::string(e.what_without_backtrace()) + ")");
+  }
+  c10::IValue format;
+  if (!archive.try_read("format", format) || !format.isString() ||
+      format.toStringRef() != "mimic2d.checkpoint.v1") {
+    throw InputError(path, "not a mimic2d checkpoint");
+  }
+  return archive;
+}
+
+}  // namespace
+
+TrainConfig ReadCheckpointConfig(const std::string& path) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  c10::IValue text;
+  archive.read("config_yaml", text);
+  return LoadTrainConfigText(text.toStringRef(), path + " (embedded config)");
+}
+
+ObservationLayout ReadCheckpointLayout(const std::string& path,
+                                       int* action_size) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  torch::Tensor values;
+  archive.read("layout", values);
+  ObservationLayout layout;
+  layout.num_bodies = static_cast<int>(values[0].item<int64_t>());
+  layout.num_objects = static_cast<int>(values[1].item<int64_t>());
+  layout.num_points = static_cast<int>(values[2].item<int64_t>());
+  layout.num_future_frames = static_cast<int>(values[3].item<int64_t>());
+  *action_size = static_cast<int>(values[4].item<int64_t>());
+  return layout;
+}
+
+CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
+                                  torch::optim::Optimizer* optimizer,
+                                  InitialStates* initial_states,
+                                  const SimState& state_template) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  CheckpointCounters counters;
+  try {
+    torch::Tensor value;
+    archive.read("iteration", value);
+    counters.iteration = static_cast<int>(value.item<int64_t>());
+    archive.read("samples", value);
+    counters.samples = value.item<int64_t>();
+    archive.read("wall_time_s", value);
+    counters.wall_time_s = value.item<double>();
+    torch::serialize::InputArchive model_archive;
+    archive.read("model", model_archive);
+    model->load(model_archive);
+    if (optimizer != nullptr) {
+      torch::serialize::InputArchive optimizer_archive;
+      archive.read("optimizer", optimizer_archive);
+      optimizer->load(optimizer_archive);
+    }
+    if (initial_states != nullptr) {
+      const int64_t width = FlatStateSize(state_template);
+      for (int b = 0; b < initial_states->num_bundles(); ++b) {
+        std::string prefix = "asi_" + std::to_string(b) + "_";
+        torch::Tensor states, scores, frames;
+        if (!archive.try_read(prefix + "states", states)) continue;
+        archive.read(prefix + "scores", scores);
+        archive.read(prefix + "frames", frames);
+        if (states.size(1) != width)
+          throw InputError(path, "ASI states do not fit this model");
+        StateBuffer& buffer = initial_states->buffer(b);
+        StateBuffer restored(buffer.num_frames(),
+                             StateBufferOptions(buffer.options()));
+        SimState state;
+        for (int64_t row = 0; row < states.size(0); ++row) {
+          int frame = static_cast<int>(frames[row].item<int64_t>());
+          if (frame < 0 || frame >= buffer.num_frames())
+            throw InputError(path, "ASI frame out of range");
+          UnflattenState(states[row].data_ptr<double>(), state_template,
+                         &state);
+          restored.Insert(frame, state, scores[row].item<double>());
+        }
+        buffer = std::move(restored);
+      }
+    }
+  } catch (const c10::Error& e) {
+    throw InputError(path, "checkpoint does not match this config (" +
+                               std::string(e.what_without_backtrace()) + ")");
+  }
+  return counters;
+}
+
+}  // namespace m2d

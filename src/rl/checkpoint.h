@@ -1,0 +1,46 @@
+// rl: checkpoints — the model, optimizer, counters, ASI state buffers and
+// the resolved config in one LibTorch archive, written atomically.
+#ifndef MIMIC2D_RL_CHECKPOINT_H_
+#define MIMIC2D_RL_CHECKPOINT_H_
+
+#include <torch/torch.h>
+
+#include <string>
+
+#include "env/reference.h"
+#include "rl/networks.h"
+#include "rl/train_config.h"
+
+namespace m2d {
+
+struct CheckpointCounters {
+  int iteration = 0;
+  int64_t samples = 0;
+  double wall_time_s = 0.0;
+};
+
+// Writes to a temporary file next to `path` and renames it over `path`.
+void SaveCheckpoint(const std::string& path, const TrainConfig& config,
+                    ActorCritic& model, torch::optim::Optimizer& optimizer,
+                    const CheckpointCounters& counters,
+                    const InitialStates* initial_states,
+                    const SimState& state_template);
+
+// The config embedded in a checkpoint; InputError naming the file if it is
+// not a mimic2d checkpoint.
+TrainConfig ReadCheckpointConfig(const std::string& path);
+
+// The observation layout and action size the checkpoint's networks take.
+ObservationLayout ReadCheckpointLayout(const std::string& path,
+                                       int* action_size);
+
+// Loads what SaveCheckpoint wrote into objects built from the same config.
+// `optimizer` and `initial_states` may be null (evaluation).
+CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
+                                  torch::optim::Optimizer* optimizer,
+                                  InitialStates* initial_states,
+                                  const SimState& state_template);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_RL_CHECKPOINT_H_

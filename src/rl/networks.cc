@@ -1,0 +1,128 @@
+#include "rl/networks.h"
+
+#include <cmath>
+
+namespace m2d {
+
+RunningNormalizerImpl::RunningNormalizerImpl(int size) {
+  mean = register_buffer("mean", torch::zeros({size}));
+  variance = register_buffer("variance", torch::ones({size}));
+  count = register_buffer("count", torch::full({1}, 1e-4));
+}
+
+void RunningNormalizerImpl::Update(const torch::Tensor& batch) {
+  torch::NoGradGuard no_grad;
+  torch::Tensor batch_mean = batch.mean(0);
+  torch::Tensor batch_variance = batch.var(0, /*unbiased=*/false);
+  double n = static_cast<double>(batch.size(0));
+  torch::Tensor total = count + n;
+  torch::Tensor delta = batch_mean - mean;
+  torch::Tensor new_mean = mean + delta * (n / total);
+  torch::Tensor m2 = variance * count + batch_variance * n +
+                     delta.pow(2) * count * (n / total);
+  mean.copy_(new_mean);
+  variance.copy_(m2 / total);
+  count.copy_(total);
+}
+
+torch::Tensor RunningNormalizerImpl::Normalize(const torch::Tensor& x) const {
+  return ((x - mean) / torch::sqrt(variance + 1e-8)).clamp(-5.0, 5.0);
+}
+
+torch::nn::Sequential MakeMlp(int input, const std::vector<int>& hidden,
+                              int output, double last_layer_gain) {
+  torch::nn::Sequential mlp;
+  int width = input;
+  for (int layer : hidden) {
+    torch::nn::Linear linear(width, layer);
+    torch::nn::init::orthogonal_(linear->weight, std::sqrt(2.0));
+    torch::nn::init::zeros_(linear->bias);
+    mlp->push_back(linear);
+    mlp->push_back(torch::nn::ReLU());
+    width = layer;
+  }
+  torch::nn::Linear last(width, output);
+  torch::nn::init::orthogonal_(last->weight, last_layer_gain);
+  torch::nn::init::zeros_(last->bias);
+  mlp->push_back(last);
+  return mlp;
+}
+
+ActorCriticImpl::ActorCriticImpl(const ObservationLayout& layout,
+                                 const ModelOptions& options, int action_size)
+    : layout_(layout),
+      base_size_(layout.view_offset()),
+      action_size_(action_size) {
+  base_normalizer =
+      register_module("base_normalizer", RunningNormalizer(base_size_));
+  view_normalizer =
+      register_module("view_normalizer", RunningNormalizer(layout.view_size()));
+  // phi ends in a ReLU so that averaging over views mixes features of the
+  // same kind (non-negative activations), as in the paper's aggregation.
+  auto make_encoder = [&]() {
+    torch::nn::Sequential encoder =
+        MakeMlp(layout.view_size(), options.encoder_hidden,
+                options.encoder_features, std::sqrt(2.0));
+    encoder->push_back(torch::nn::ReLU());
+    return encoder;
+  };
+  actor_encoder = register_module("actor_encoder", make_encoder());
+  critic_encoder = register_module("critic_encoder", make_encoder());
+  const int joined = base_size_ + options.encoder_features;
+  actor = register_module(
+      "actor", MakeMlp(joined, options.policy_hidden, action_size, 0.01));
+  critic =
+      register_module("critic", MakeMlp(joined, options.critic_hidden, 1, 1.0));
+  log_std = register_parameter(
+      "log_std", torch::full({action_size}, std::log(options.action_std)),
+      /*requires_grad=*/options.learn_action_std);
+}
+
+torch::Tensor ActorCriticImpl::Normalize(const torch::Tensor& raw) const {
+  const int64_t batch = raw.size(0);
+  torch::Tensor base = base_normalizer->Normalize(raw.narrow(1, 0, base_size_));
+  torch::Tensor views = raw.narrow(1, base_size_, raw.size(1) - base_size_)
+                            .reshape({batch, -1, layout_.view_size()});
+  views = view_normalizer->Normalize(views).reshape({batch, -1});
+  return torch::cat({base, views}, 1);
+}
+
+void ActorCriticImpl::UpdateNormalizer(const torch::Tensor& raw) {
+  base_normalizer->Update(raw.narrow(1, 0, base_size_));
+  view_normalizer->Update(raw.narrow(1, base_size_, raw.size(1) - base_size_)
+                              .reshape({-1, layout_.view_size()}));
+}
+
+torch::Tensor ActorCriticImpl::Features(torch::nn::Sequential& encoder,
+                                        const torch::Tensor& obs,
+                                        int num_views) {
+  const int64_t batch = obs.size(0);
+  torch::Tensor views =
+      obs.narrow(1, base_size_,
+                 static_cast<int64_t>(num_views) * layout_.view_size())
+          .reshape({batch * num_views, layout_.view_size()});
+  torch::Tensor phi =
+      encoder->forward(views).reshape({batch, num_views, -1}).mean(1);
+  return torch::cat({obs.narrow(1, 0, base_size_), phi}, 1);
+}
+
+torch::Tensor ActorCriticImpl::ActionMean(const torch::Tensor& obs,
+                                          int num_views) {
+  return actor->forward(Features(actor_encoder, obs, num_views));
+}
+
+torch::Tensor ActorCriticImpl::Value(const torch::Tensor& obs, int num_views) {
+  return critic->forward(Features(critic_encoder, obs, num_views)).squeeze(1);
+}
+
+torch::Tensor ActorCriticImpl::LogProb(const torch::Tensor& mean,
+                                       const torch::Tensor& actions) const {
+  torch::Tensor z = (actions - mean) * torch::exp(-log_std);
+  return (-0.5 * z.pow(2) - log_std - 0.5 * std::log(2.0 * M_PI)).sum(1);
+}
+
+torch::Tensor ActorCriticImpl::Entropy() const {
+  return (log_std + 0.5 * std::log(2.0 * M_PI * M_E)).sum();
+}
+
+}  // namespace m2d

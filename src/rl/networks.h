@@ -1,0 +1,71 @@
+// rl: the actor-critic networks. The 2D block of the observation (current
+// projection + future reference, per view) goes through an encoder phi;
+// phi's features are averaged over the K views given (K = 1 in training,
+// K > 1 for zero-shot multi-view tracking); proprioception and object state
+// join after phi. Policy: MLP -> Gaussian mean over normalized PD targets.
+#ifndef MIMIC2D_RL_NETWORKS_H_
+#define MIMIC2D_RL_NETWORKS_H_
+
+#include <torch/torch.h>
+
+#include "env/observation.h"
+#include "rl/train_config.h"
+
+namespace m2d {
+
+// Running mean and variance of observation features (Chan et al.'s
+// parallel update), kept as buffers so they are saved with the model.
+class RunningNormalizerImpl : public torch::nn::Module {
+ public:
+  explicit RunningNormalizerImpl(int size);
+  void Update(const torch::Tensor& batch);                // [B, size]
+  torch::Tensor Normalize(const torch::Tensor& x) const;  // clipped to +-5
+
+  torch::Tensor mean, variance, count;
+};
+TORCH_MODULE(RunningNormalizer);
+
+// Linear layers with ReLU between them (none after the last).
+torch::nn::Sequential MakeMlp(int input, const std::vector<int>& hidden,
+                              int output, double last_layer_gain);
+
+class ActorCriticImpl : public torch::nn::Module {
+ public:
+  ActorCriticImpl(const ObservationLayout& layout, const ModelOptions& options,
+                  int action_size);
+
+  // Raw observations [B, base + K * view] -> normalized (same shape).
+  torch::Tensor Normalize(const torch::Tensor& raw) const;
+  void UpdateNormalizer(const torch::Tensor& raw);
+
+  // On normalized observations with `num_views` view blocks.
+  torch::Tensor ActionMean(const torch::Tensor& obs, int num_views = 1);
+  torch::Tensor Value(const torch::Tensor& obs, int num_views = 1);  // [B]
+  torch::Tensor LogStd() const { return log_std; }
+
+  // Log-density of `actions` under N(mean, sigma) summed over dimensions.
+  torch::Tensor LogProb(const torch::Tensor& mean,
+                        const torch::Tensor& actions) const;
+  torch::Tensor Entropy() const;  // of the diagonal Gaussian, scalar
+
+  const ObservationLayout& layout() const { return layout_; }
+  int action_size() const { return action_size_; }
+
+ private:
+  // phi averaged over the views, joined with the base features.
+  torch::Tensor Features(torch::nn::Sequential& encoder,
+                         const torch::Tensor& obs, int num_views);
+
+  ObservationLayout layout_;
+  int base_size_;
+  int action_size_;
+  RunningNormalizer base_normalizer{nullptr}, view_normalizer{nullptr};
+  torch::nn::Sequential actor_encoder{nullptr}, critic_encoder{nullptr};
+  torch::nn::Sequential actor{nullptr}, critic{nullptr};
+  torch::Tensor log_std;
+};
+TORCH_MODULE(ActorCritic);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_RL_NETWORKS_H_

@@ -1,0 +1,359 @@
+#include "rl/trainer.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <ATen/Parallel.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.h"
+#include "common/file_io.h"
+#include "env/vec_env.h"
+#include "motion/bundle.h"
+#include "rl/checkpoint.h"
+#include "rl/ppo.h"
+
+namespace m2d {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+constexpr char kLogHeader[] =
+    "iteration,samples,wall_time_s,samples_per_s,mean_return,mean_episode_"
+    "length,succ,e2d_px,"
+    "policy_loss,value_loss,entropy,learning_rate";
+
+// Keeps the log rows up to `iteration` (a resumed run rewrites what came
+// after its checkpoint).
+void TrimLog(const std::string& path, int iteration) {
+  std::ifstream in(path);
+  std::ostringstream kept;
+  kept << kLogHeader << "\n";
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (std::stoi(line.substr(0, line.find(','))) <= iteration)
+      kept << line << "\n";
+  }
+  WriteFileAtomic(path, kept.str());
+}
+
+// A visited state offered to the ASI buffers.
+struct CapturedState {
+  int bundle = 0;
+  int frame = 0;
+  SimState state;
+};
+
+}  // namespace
+
+struct Trainer::State {
+  TrainConfig config;
+  std::string log_path, checkpoint_path;
+  std::shared_ptr<const Character> character;
+  std::shared_ptr<const TrackingReference> reference;
+  std::shared_ptr<InitialStates> initial_states;
+  std::unique_ptr<VecEnv> envs;
+  std::unique_ptr<TrackingEnv> scoring_env;  // for rescoring ASI entries
+  ActorCritic model{nullptr};
+  std::unique_ptr<torch::optim::Adam> optimizer;
+  torch::Generator generator;
+  std::mt19937_64 rng;
+  SimState state_template;
+  CheckpointCounters counters;
+  std::vector<CapturedState> captured;
+  std::vector<float> captured_observations;
+
+  torch::Tensor Normalized(const torch::Tensor& raw) {
+    return config.ppo.normalize_observations ? model->Normalize(raw) : raw;
+  }
+  void Collect(RolloutStorage& storage, std::vector<FinishedEpisode>* finished);
+  void UpdateStateBuffers();
+  void Save() {
+    SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
+                   initial_states.get(), state_template);
+  }
+};
+
+Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
+  State& s = *state_;
+  s.config = config;
+  const RunOptions& run = config.run;
+  std::filesystem::create_directories(run.run_dir);
+  s.log_path = run.run_dir + "/train_log.csv";
+  s.checkpoint_path = run.run_dir + "/checkpoint.pt";
+  at::set_num_threads(config.ppo.torch_threads);
+  torch::manual_seed(run.seed);
+  s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
+  s.rng.seed(run.seed);
+
+  // Outline: character and references -> initial states -> environments ->
+  // networks and optimizer -> (resume) checkpoint -> log.
+  s.character = LoadCharacterForSimulation(
+      config.data.character_config, config.data.scene, config.env.simulation);
+  std::vector<ReferenceBundle> bundles;
+  for (const std::string& path : config.data.bundles)
+    bundles.push_back(ReadBundle(path));
+  s.reference = TrackingReference::Prepare(std::move(bundles), *s.character,
+                                           config.env.simulation.control_hz);
+  s.initial_states = std::make_shared<InitialStates>(
+      *s.reference, s.character, config.env.simulation, config.asi.buffer);
+  s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
+                                    config.env, config.ppo.num_envs, run.seed,
+                                    run.env_threads);
+  s.scoring_env =
+      std::make_unique<TrackingEnv>(s.character, s.reference, s.initial_states,
+                                    config.env, run.seed + 1'000'003);
+  s.state_template = s.envs->env(0).simulation().Save();
+  s.model = ActorCritic(s.envs->layout(), config.model, s.envs->action_size());
+  s.optimizer = std::make_unique<torch::optim::Adam>(
+      s.model->parameters(),
+      torch::optim::AdamOptions(config.ppo.learning_rate));
+
+  if (resume && std::filesystem::exists(s.checkpoint_path)) {
+    s.counters = LoadCheckpoint(s.checkpoint_path, s.model, s.optimizer.get(),
+                                s.initial_states.get(), s.state_template);
+    // A different stream after resuming: the interrupted iteration's
+    // randomness is not replayed.
+    s.generator = at::make_generator<at::CPUGeneratorImpl>(
+        run.seed + s.counters.iteration);
+    spdlog::info("resumed from {} at iteration {} ({} samples)",
+                 s.checkpoint_path, s.counters.iteration, s.counters.samples);
+    TrimLog(s.log_path, s.counters.iteration);
+  } else {
+    if (resume)
+      spdlog::warn("--resume: no checkpoint at {}; starting fresh",
+                   s.checkpoint_path);
+    WriteFileAtomic(s.log_path, std::string(kLogHeader) + "\n");
+  }
+  WriteFileAtomic(run.run_dir + "/config.yaml", TrainConfigToYaml(config));
+}
+
+Trainer::~Trainer() = default;
+
+const std::string& Trainer::checkpoint_path() const {
+  return state_->checkpoint_path;
+}
+
+void Trainer::State::Collect(RolloutStorage& storage,
+                             std::vector<FinishedEpisode>* finished) {
+  // Outline per step: normalize observations, sample actions from the
+  // Gaussian policy, step every environment in parallel, fold the value of
+  // truncated episodes' last observations into their reward, offer visited
+  // states to ASI.
+  torch::NoGradGuard no_grad;
+  VecEnv& vec = *envs;
+  const int num_envs = vec.num_envs();
+  const int observation_size = vec.observation_size();
+  const int action_size = vec.action_size();
+  const int steps = config.ppo.steps_per_env;
+  const double discount = config.ppo.discount;
+  captured.clear();
+  captured_observations.clear();
+
+  for (int t = 0; t < steps; ++t) {
+    torch::Tensor raw =
+        torch::from_blob(vec.observations(), {num_envs, observation_size});
+    if (config.ppo.normalize_observations) model->UpdateNormalizer(raw);
+    torch::Tensor obs = Normalized(raw);
+    torch::Tensor mean = model->ActionMean(obs);
+    torch::Tensor value = model->Value(obs);
+    torch::Tensor noise = at::randn({num_envs, action_size}, generator);
+    torch::Tensor action = (mean + model->LogStd().exp() * noise).contiguous();
+    storage.observations[t].copy_(obs);
+    storage.actions[t].copy_(action);
+    storage.log_probs[t].copy_(model->LogProb(mean, action));
+    storage.values[t].copy_(value);
+    std::memcpy(vec.actions(), action.data_ptr<float>(),
+                sizeof(float) * num_envs * action_size);
+
+    vec.Step(finished);
+
+    torch::Tensor reward =
+        torch::from_blob(const_cast<float*>(vec.rewards()), {num_envs}).clone();
+    std::vector<int64_t> truncated_rows;
+    for (int i = 0; i < num_envs; ++i) {
+      storage.dones[t][i] =
+          (vec.terminated()[i] || vec.truncated()[i]) ? 1.0f : 0.0f;
+      if (vec.truncated()[i]) truncated_rows.push_back(i);
+    }
+    if (!truncated_rows.empty()) {
+      // Time limits are not failures: bootstrap with V(last observation).
+      torch::Tensor rows = torch::tensor(truncated_rows, torch::kLong);
+      torch::Tensor final_raw =
+          torch::from_blob(const_cast<float*>(vec.final_observations()),
+                           {num_envs, observation_size})
+              .index_select(0, rows);
+      reward.index_add_(0, rows,
+                        discount * model->Value(Normalized(final_raw)));
+    }
+    storage.rewards[t].copy_(reward);
+
+    if (config.asi.enabled && t % config.asi.capture_every_steps == 0) {
+      for (int i = 0; i < num_envs; ++i) {
+        if (vec.terminated()[i] || vec.truncated()[i]) continue;
+        TrackingEnv& env = vec.env(i);
+        captured.push_back(
+            {env.view().bundle, env.frame(), env.simulation().Save()});
+        const float* row =
+            vec.observations() + static_cast<size_t>(i) * observation_size;
+        captured_observations.insert(captured_observations.end(), row,
+                                     row + observation_size);
+      }
+    }
+  }
+  torch::Tensor last_raw =
+      torch::from_blob(vec.observations(), {num_envs, observation_size});
+  torch::Tensor last_values = model->Value(Normalized(last_raw));
+  ComputeGae(storage.rewards, storage.values, storage.dones, last_values,
+             discount, config.ppo.gae_lambda, &storage.advantages,
+             &storage.returns);
+}
+
+void Trainer::State::UpdateStateBuffers() {
+  // ASI: the critic scores the captured visited states; each replaces the
+  // lowest-scoring state of its frame if it scores higher. Every few
+  // iterations all kept states are rescored, since the critic moves.
+  torch::NoGradGuard no_grad;
+  const int observation_size = envs->observation_size();
+  if (!captured.empty()) {
+    torch::Tensor raw = torch::from_blob(
+        captured_observations.data(),
+        {static_cast<int64_t>(captured.size()), observation_size});
+    torch::Tensor scores =
+        model->Value(Normalized(raw)).to(torch::kDouble).contiguous();
+    const double* score = scores.data_ptr<double>();
+    for (size_t i = 0; i < captured.size(); ++i) {
+      initial_states->buffer(captured[i].bundle)
+          .Insert(captured[i].frame, captured[i].state, score[i]);
+    }
+  }
+  constexpr int kRescoreEveryIterations = 10;
+  if (counters.iteration % kRescoreEveryIterations != 0) return;
+  std::vector<float> observation(observation_size);
+  const std::vector<TrackedView>& views = reference->views();
+  for (int b = 0; b < initial_states->num_bundles(); ++b) {
+    std::vector<int> bundle_views;
+    for (size_t v = 0; v < views.size(); ++v) {
+      if (views[v].bundle == b) bundle_views.push_back(static_cast<int>(v));
+    }
+    StateBuffer& buffer = initial_states->buffer(b);
+    std::vector<float> batch;
+    std::vector<std::pair<int, int>> slots;
+    for (int f = 0; f < buffer.num_frames(); ++f) {
+      for (int i = 0; i < buffer.size(f); ++i) {
+        int view = bundle_views[std::uniform_int_distribution<size_t>(
+            0, bundle_views.size() - 1)(rng)];
+        scoring_env->ResetTo(view, f, buffer.entry(f, i).state,
+                             observation.data());
+        batch.insert(batch.end(), observation.begin(), observation.end());
+        slots.push_back({f, i});
+      }
+    }
+    torch::Tensor raw = torch::from_blob(
+        batch.data(), {static_cast<int64_t>(slots.size()), observation_size});
+    torch::Tensor scores =
+        model->Value(Normalized(raw)).to(torch::kDouble).contiguous();
+    for (size_t k = 0; k < slots.size(); ++k) {
+      buffer.Rescore(slots[k].first, slots[k].second,
+                     scores.data_ptr<double>()[k]);
+    }
+  }
+}
+
+TrainSummary Trainer::Run(
+    int max_iterations, const std::atomic<bool>* stop,
+    const std::function<void(const TrainProgress&)>& on_progress) {
+  State& s = *state_;
+  const TrainConfig& config = s.config;
+  TrainSummary summary;
+  summary.checkpoint_path = s.checkpoint_path;
+  RolloutStorage storage(config.ppo.steps_per_env, config.ppo.num_envs,
+                         s.envs->observation_size(), s.envs->action_size());
+  s.envs->Reset();
+  Clock::time_point last_checkpoint = Clock::now();
+  std::ofstream log(s.log_path, std::ios::app);
+
+  while (s.counters.samples < config.run.total_samples) {
+    if (stop != nullptr && stop->load()) {
+      summary.interrupted = true;
+      break;
+    }
+    if (max_iterations > 0 && summary.iterations_run >= max_iterations) break;
+    // 1. Collect a batch of experience.
+    Clock::time_point start = Clock::now();
+    std::vector<FinishedEpisode> finished;
+    s.Collect(storage, &finished);
+    double collect_s = SecondsSince(start);
+    // 2. Learn from it.
+    Clock::time_point update_start = Clock::now();
+    PpoLosses losses =
+        PpoUpdate(s.model, *s.optimizer, storage, config.ppo, s.generator);
+    double update_s = SecondsSince(update_start);
+    // 3. Refresh the initial-state buffers (ASI).
+    Clock::time_point asi_start = Clock::now();
+    ++s.counters.iteration;
+    if (config.asi.enabled) s.UpdateStateBuffers();
+    double asi_s = SecondsSince(asi_start);
+
+    // 4. Report.
+    double iteration_s = SecondsSince(start);
+    s.counters.samples += config.ppo.batch_size();
+    s.counters.wall_time_s += iteration_s;
+    TrainProgress progress;
+    progress.iteration = s.counters.iteration;
+    progress.samples = s.counters.samples;
+    progress.wall_time_s = s.counters.wall_time_s;
+    progress.samples_per_s = config.ppo.batch_size() / iteration_s;
+    progress.collect_s = collect_s;
+    progress.update_s = update_s;
+    progress.asi_s = asi_s;
+    if (!finished.empty()) {
+      double returns = 0, lengths = 0, successes = 0, errors = 0;
+      for (const FinishedEpisode& episode : finished) {
+        returns += episode.stats.total_reward;
+        lengths += episode.stats.steps;
+        successes += episode.stats.failed ? 0.0 : 1.0;
+        errors += episode.stats.mean_error_px();
+      }
+      const double count = static_cast<double>(finished.size());
+      progress.mean_return = returns / count;
+      progress.mean_episode_length = lengths / count;
+      progress.succ = successes / count;
+      progress.e2d_px = errors / count;
+    }
+    progress.policy_loss = losses.policy_loss;
+    progress.value_loss = losses.value_loss;
+    progress.entropy = losses.entropy;
+    progress.learning_rate = config.ppo.learning_rate;
+    log << progress.iteration << ',' << progress.samples << ','
+        << progress.wall_time_s << ',' << progress.samples_per_s << ','
+        << progress.mean_return << ',' << progress.mean_episode_length << ','
+        << progress.succ << ',' << progress.e2d_px << ','
+        << progress.policy_loss << ',' << progress.value_loss << ','
+        << progress.entropy << ',' << progress.learning_rate << '\n';
+    log.flush();
+    if (on_progress) on_progress(progress);
+    summary.last = progress;
+    ++summary.iterations_run;
+
+    // 5. Checkpoint every few minutes.
+    if (SecondsSince(last_checkpoint) > 60.0 * config.run.checkpoint_minutes) {
+      s.Save();
+      last_checkpoint = Clock::now();
+    }
+  }
+  s.Save();
+  return summary;
+}
+
+}  // namespace m2d

@@ -1,0 +1,143 @@
+#include "rl/ppo.h"
+
+#include <gtest/gtest.h>
+
+#include "common/error.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+TEST(Gae, MatchesAHandComputedExample) {
+  // Two steps, one env; the episode ends after step 1.
+  torch::Tensor rewards = torch::tensor({{1.0f}, {2.0f}});
+  torch::Tensor values = torch::tensor({{0.5f}, {1.0f}});
+  torch::Tensor dones = torch::tensor({{0.0f}, {1.0f}});
+  torch::Tensor last = torch::tensor({7.0f});  // ignored: episode ended
+  torch::Tensor advantages, returns;
+  ComputeGae(rewards, values, dones, last, 0.9, 0.8, &advantages, &returns);
+  // delta_1 = 2 - 1 = 1; A_1 = 1.
+  // delta_0 = 1 + 0.9 * 1.0 - 0.5 = 1.4; A_0 = 1.4 + 0.9 * 0.8 * 1 = 2.12.
+  EXPECT_NEAR(advantages[1][0].item<float>(), 1.0f, 1e-6);
+  EXPECT_NEAR(advantages[0][0].item<float>(), 2.12f, 1e-6);
+  EXPECT_NEAR(returns[0][0].item<float>(), 2.62f, 1e-6);
+}
+
+TEST(Gae, BootstrapsFromTheLastValueWhenNotDone) {
+  torch::Tensor rewards = torch::tensor({{0.0f, 0.0f}});
+  torch::Tensor values = torch::tensor({{0.0f, 0.0f}});
+  torch::Tensor dones = torch::tensor({{0.0f, 1.0f}});
+  torch::Tensor last = torch::tensor({10.0f, 10.0f});
+  torch::Tensor advantages, returns;
+  ComputeGae(rewards, values, dones, last, 0.5, 1.0, &advantages, &returns);
+  EXPECT_NEAR(advantages[0][0].item<float>(), 5.0f, 1e-6);
+  EXPECT_NEAR(advantages[0][1].item<float>(), 0.0f, 1e-6);
+}
+
+ObservationLayout SmallLayout() {
+  ObservationLayout layout;
+  layout.num_bodies = 2;
+  layout.num_points = 3;
+  layout.num_future_frames = 2;
+  return layout;
+}
+
+TEST(Networks, AveragingIdenticalViewsEqualsOneView) {
+  torch::manual_seed(0);
+  ObservationLayout layout = SmallLayout();
+  ModelOptions options;
+  options.policy_hidden = {32};
+  options.critic_hidden = {32};
+  options.encoder_hidden = {16};
+  options.encoder_features = 8;
+  ActorCritic model(layout, options, 4);
+  torch::Tensor base = torch::randn({5, layout.view_offset()});
+  torch::Tensor view = torch::randn({5, layout.view_size()});
+  torch::Tensor one = torch::cat({base, view}, 1);
+  torch::Tensor three = torch::cat({base, view, view, view}, 1);
+  EXPECT_TRUE(torch::allclose(model->ActionMean(one, 1),
+                              model->ActionMean(three, 3), 1e-5, 1e-6));
+  EXPECT_TRUE(torch::allclose(model->Value(one, 1), model->Value(three, 3),
+                              1e-5, 1e-6));
+  // Views are order-free: swapping two views changes nothing.
+  torch::Tensor other = torch::randn({5, layout.view_size()});
+  torch::Tensor ab = torch::cat({base, view, other}, 1);
+  torch::Tensor ba = torch::cat({base, other, view}, 1);
+  EXPECT_TRUE(torch::allclose(model->ActionMean(ab, 2),
+                              model->ActionMean(ba, 2), 1e-5, 1e-6));
+}
+
+TEST(Networks, RunningNormalizerTracksMeanAndVariance) {
+  RunningNormalizer normalizer(2);
+  torch::manual_seed(1);
+  for (int i = 0; i < 20; ++i) {
+    torch::Tensor batch = torch::randn({500, 2}) * torch::tensor({2.0f, 0.5f}) +
+                          torch::tensor({3.0f, -1.0f});
+    normalizer->Update(batch);
+  }
+  EXPECT_NEAR(normalizer->mean[0].item<float>(), 3.0f, 0.05f);
+  EXPECT_NEAR(normalizer->mean[1].item<float>(), -1.0f, 0.02f);
+  EXPECT_NEAR(normalizer->variance[0].item<float>(), 4.0f, 0.2f);
+  EXPECT_NEAR(normalizer->variance[1].item<float>(), 0.25f, 0.02f);
+}
+
+TEST(Networks, LogProbMatchesTheGaussianDensity) {
+  ObservationLayout layout = SmallLayout();
+  ModelOptions options;
+  options.action_std = 0.5;
+  ActorCritic model(layout, options, 2);
+  torch::Tensor mean = torch::zeros({1, 2});
+  torch::Tensor action = torch::tensor({{0.5f, -1.0f}});
+  double expected = 0.0;
+  for (double a : {0.5, -1.0})
+    expected +=
+        -0.5 * (a / 0.5) * (a / 0.5) - std::log(0.5) - 0.5 * std::log(2 * M_PI);
+  EXPECT_NEAR(model->LogProb(mean, action).item<float>(), expected, 1e-5);
+}
+
+TEST(PpoUpdate, ReducesTheLossOnAFixedBatch) {
+  // A batch where action +0.5 earned a positive advantage: after updates the
+  // mean action moves toward it.
+  torch::manual_seed(2);
+  ObservationLayout layout = SmallLayout();
+  ModelOptions options;
+  options.policy_hidden = {32};
+  options.critic_hidden = {32};
+  ActorCritic model(layout, options, 1);
+  RolloutStorage storage(8, 16, layout.size(), 1);
+  storage.observations.normal_();
+  {
+    torch::NoGradGuard no_grad;
+    torch::Tensor obs = storage.observations.reshape({128, -1});
+    torch::Tensor mean = model->ActionMean(obs);
+    torch::Tensor action = mean + 0.5;
+    storage.actions.copy_(action.reshape({8, 16, 1}));
+    storage.log_probs.copy_(model->LogProb(mean, action).reshape({8, 16}));
+    storage.advantages.fill_(0.0);
+    storage.advantages.index_put_(
+        {torch::indexing::Slice(), torch::indexing::Slice(0, 8)}, 1.0);
+    storage.advantages.index_put_(
+        {torch::indexing::Slice(), torch::indexing::Slice(8, 16)}, -1.0);
+    storage.returns.fill_(1.0);
+  }
+  PpoOptions ppo;
+  ppo.num_envs = 16;
+  ppo.steps_per_env = 8;
+  ppo.minibatch_size = 32;
+  ppo.epochs = 4;
+  torch::optim::Adam optimizer(model->parameters(),
+                               torch::optim::AdamOptions(1e-3));
+  torch::Generator generator = at::detail::createCPUGenerator(3);
+  torch::Tensor obs = storage.observations.reshape({128, -1});
+  double before =
+      torch::mean(torch::abs(model->Value(obs) - 1.0)).item<double>();
+  PpoLosses losses = PpoUpdate(model, optimizer, storage, ppo, generator);
+  double after =
+      torch::mean(torch::abs(model->Value(obs) - 1.0)).item<double>();
+  EXPECT_LT(after, before);
+  EXPECT_TRUE(std::isfinite(losses.policy_loss));
+  EXPECT_GT(losses.clip_fraction, 0.0);
+}
+
+}  // namespace
+}  // namespace m2d

@@ -1,0 +1,76 @@
+#include "rl/train_config.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "common/error.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+std::string Write(const std::string& dir, const std::string& name,
+                  const std::string& text) {
+  std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(TrainConfig, ReadsSectionsInlineOrFromFilesAndRoundTrips) {
+  std::string dir = testing::TempDir("train_config");
+  Write(dir, "agent.yaml",
+        "num_envs: 8\nsteps_per_env: 16\nminibatch_size: 64\n");
+  std::string path =
+      Write(dir, "config.yaml",
+            "data: {bundles: [a.json]}\n"
+            "env: {num_future_frames: 3, reward: {pose_alpha_per_px: 0.01}}\n"
+            "agent: agent.yaml\n"
+            "run: {seed: 9}\n");
+  TrainConfig config = LoadTrainConfig(path);
+  EXPECT_EQ(config.ppo.num_envs, 8);
+  EXPECT_EQ(config.ppo.minibatch_size, 64);
+  EXPECT_EQ(config.env.num_future_frames, 3);
+  EXPECT_DOUBLE_EQ(config.env.reward.pose_alpha_per_px, 0.01);
+  EXPECT_EQ(config.run.seed, 9u);
+  EXPECT_EQ(config.model.policy_hidden, (std::vector<int>{512, 256, 256}));
+
+  TrainConfig again = LoadTrainConfigText(TrainConfigToYaml(config), "text");
+  EXPECT_EQ(TrainConfigToYaml(again), TrainConfigToYaml(config));
+}
+
+// `names_config`: the message names the config file itself (false when the
+// problem is in a section file, which the message names instead).
+void ExpectConfigError(const std::string& text, const std::string& needle,
+                       bool names_config = true) {
+  std::string dir = testing::TempDir("train_config_bad");
+  std::string path = Write(dir, "bad.yaml", text);
+  try {
+    LoadTrainConfig(path);
+    FAIL() << "expected InputError for: " << text;
+  } catch (const InputError& e) {
+    std::string message = e.what();
+    if (names_config)
+      EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(needle), std::string::npos) << message;
+  }
+}
+
+TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envz: 3}\n",
+                    "'agent.num_envz' is not a known setting");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envs: many}\n",
+                    "'agent.num_envs' has the wrong type");
+  ExpectConfigError("data: {bundles: []}\n", "data.bundles");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {discount: 1.5}\n",
+                    "discount");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: missing.yaml\n",
+                    "missing.yaml: cannot open file", false);
+  ExpectConfigError("data: [\n", "malformed YAML");
+  ExpectConfigError(
+      "data: {bundles: [a.json]}\nagent: {minibatch_size: 100000}\n",
+      "minibatch_size");
+}
+
+}  // namespace
+}  // namespace m2d
