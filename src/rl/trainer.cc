@@ -79,8 +79,8 @@ struct Trainer::State {
   void Collect(RolloutStorage& storage, std::vector<FinishedEpisode>* finished);
   void UpdateStateBuffers();
   void Save() {
-    SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
-                   initial_states.get(), state_template);
+    m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
+                        initial_states.get(), state_template);
   }
 };
 
@@ -143,6 +143,8 @@ Trainer::~Trainer() = default;
 const std::string& Trainer::checkpoint_path() const {
   return state_->checkpoint_path;
 }
+
+void Trainer::SaveCheckpoint() { state_->Save(); }
 
 void Trainer::State::Collect(RolloutStorage& storage,
                              std::vector<FinishedEpisode>* finished) {

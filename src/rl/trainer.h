@@ -48,6 +48,8 @@ class Trainer {
       int max_iterations, const std::atomic<bool>* stop,
       const std::function<void(const TrainProgress&)>& on_progress);
 
+  // Writes the checkpoint now (e.g. of the untrained policy, as a baseline).
+  void SaveCheckpoint();
   const std::string& checkpoint_path() const;
 
  private:
