@@ -12,7 +12,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # libqhull-dev: mujoco's CMake target names /usr/include/libqhull_r
   libmujoco-dev libqhull-dev libtorch-dev libceres-dev libassimp-dev assimp-testmodels
-  libosmesa6-dev ffmpeg gnuplot-nox
+  # libcairo2-dev: overlays, PNG and text on rendered frames (brings glib)
+  libosmesa6-dev libcairo2-dev ffmpeg gnuplot-nox
 )
 
 missing=()

@@ -1,0 +1,348 @@
+#include "render/episode_renderer.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/error.h"
+#include "env/reward.h"
+#include "render/gl_camera.h"
+#include "render/overlay.h"
+
+namespace m2d {
+namespace {
+
+std::string FormatE2d(double e2d_px) {
+  if (!std::isfinite(e2d_px)) return "E2D n/a";
+  char text[48];
+  std::snprintf(text, sizeof(text), "E2D %.1f px", e2d_px);
+  return text;
+}
+
+std::string PngName(int clip_frame) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "frame_%06d.png", clip_frame);
+  return name;
+}
+
+// Keypoints scaled from clip pixels to output pixels.
+std::vector<Keypoint2D> ScaleKeypoints(const std::vector<Keypoint2D>& points,
+                                       double scale) {
+  std::vector<Keypoint2D> scaled = points;
+  for (Keypoint2D& point : scaled) {
+    point.x_px *= scale;
+    point.y_px *= scale;
+  }
+  return scaled;
+}
+
+Eigen::Vector3d MeanPoint(const std::vector<Eigen::Vector3d>& points,
+                          const Eigen::Vector3d& fallback) {
+  if (points.empty()) return fallback;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& point : points) sum += point;
+  return sum / static_cast<double>(points.size());
+}
+
+}  // namespace
+
+bool RecordedFrames::Next(EpisodeFrame* frame) {
+  if (next_ >= frames_.size()) return false;
+  *frame = frames_[next_++];
+  return true;
+}
+
+void EpisodeRenderOptions::Validate() const {
+  if (!(std::isfinite(scale) && scale > 0 && scale <= 4)) {
+    throw ConfigError("render scale must be in (0, 4]");
+  }
+  if (side_camera) side.Validate();
+}
+
+void EpisodeOutputOptions::Validate() const {
+  if (video_path.empty() && png_folder.empty()) {
+    throw ConfigError(
+        "render: nothing to write (no video path, no PNG folder)");
+  }
+  if (first_frame < 0) throw ConfigError("render: first frame must be >= 0");
+  if (last_frame >= 0 && last_frame < first_frame) {
+    throw ConfigError("render: last frame is before the first frame");
+  }
+  if (!video_path.empty()) video.Validate();
+}
+
+EpisodeRenderer::EpisodeRenderer(std::shared_ptr<const Character> character,
+                                 const SimulationOptions& simulation,
+                                 const KeypointLayout& layout,
+                                 int image_width_px, int image_height_px,
+                                 const EpisodeRenderOptions& options)
+    : character_(std::move(character)),
+      layout_(&layout),
+      options_(options),
+      simulation_(character_, simulation),
+      image_width_px_(image_width_px),
+      image_height_px_(image_height_px) {
+  options_.Validate();
+  if (layout.name != character_->keypoint_layout().name) {
+    throw InputError(character_->config().source_path,
+                     "the reference uses keypoint layout '" + layout.name +
+                         "', the character's keypoints are '" +
+                         character_->keypoint_layout().name + "'");
+  }
+  Intrinsics image;
+  image.width_px = image_width_px;
+  image.height_px = image_height_px;
+  const Intrinsics scaled =
+      ScaleCamera(PinholeCamera(image, Eigen::Matrix3d::Identity(),
+                                Eigen::Vector3d::Zero()),
+                  options_.scale)
+          .intrinsics();
+  panel_width_px_ = scaled.width_px;
+  panel_height_px_ = scaled.height_px;
+  SceneRenderOptions scene;
+  scene.max_width_px = panel_width_px_;
+  scene.max_height_px = panel_height_px_;
+  scene.shadows = options_.shadows;
+  scene_ = std::make_unique<SceneRenderer>(character_->model(), scene);
+}
+
+int EpisodeRenderer::width_px() const {
+  return options_.side_camera ? 2 * panel_width_px_ : panel_width_px_;
+}
+int EpisodeRenderer::height_px() const { return panel_height_px_; }
+
+std::vector<Eigen::Vector3d> EpisodeRenderer::PlaceScene(
+    const EpisodeFrame& frame) {
+  if (!frame.state) {
+    scene_->SetHiddenBodies(character_->bodies());
+    return frame.keypoints_world_m;
+  }
+  scene_->SetHiddenBodies({});
+  simulation_.Restore(*frame.state);
+  std::vector<double> xyz(3 * character_->keypoint_sites().size());
+  simulation_.KeypointPositions(xyz.data());
+  std::vector<Eigen::Vector3d> keypoints(xyz.size() / 3);
+  for (size_t j = 0; j < keypoints.size(); ++j) {
+    keypoints[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
+  }
+  return keypoints;
+}
+
+RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
+  // Outline: place the scene, draw it through the scaled camera, project
+  // the pose, measure the 2D error, draw the overlays, add the side panel.
+  const std::string where = "frame " + std::to_string(frame.clip_frame);
+  const Intrinsics& intrinsics = frame.camera.intrinsics();
+  if (intrinsics.width_px != image_width_px_ ||
+      intrinsics.height_px != image_height_px_) {
+    throw InputError("render", where + ": the camera's image is " +
+                                   std::to_string(intrinsics.width_px) + "x" +
+                                   std::to_string(intrinsics.height_px) +
+                                   " px, the clip's " +
+                                   std::to_string(image_width_px_) + "x" +
+                                   std::to_string(image_height_px_));
+  }
+  const int num_keypoints = layout_->num_keypoints();
+  if (!frame.reference.empty() &&
+      static_cast<int>(frame.reference.size()) != num_keypoints) {
+    throw InputError("render", where + ": the reference has " +
+                                   std::to_string(frame.reference.size()) +
+                                   " keypoints, layout " + layout_->name +
+                                   " has " + std::to_string(num_keypoints));
+  }
+  const std::vector<Eigen::Vector3d> pose_world_m = PlaceScene(frame);
+  if (!pose_world_m.empty() &&
+      static_cast<int>(pose_world_m.size()) != num_keypoints) {
+    throw InputError("render", where + ": the pose has " +
+                                   std::to_string(pose_world_m.size()) +
+                                   " 3D keypoints, layout " + layout_->name +
+                                   " has " + std::to_string(num_keypoints));
+  }
+  const PinholeCamera camera = ScaleCamera(frame.camera, options_.scale);
+  RenderedFrame rendered;
+  rendered.image = scene_->RenderPinhole(simulation_.mutable_data(), camera);
+
+  // The pose's projection in clip pixels, for the error, and scaled.
+  std::vector<Keypoint2D> pose_px(pose_world_m.size());
+  std::vector<double> projected_xy(2 * pose_world_m.size());
+  auto in_front = std::make_unique<bool[]>(pose_world_m.size() + 1);
+  for (size_t j = 0; j < pose_world_m.size(); ++j) {
+    const Projection projection = frame.camera.Project(pose_world_m[j]);
+    projected_xy[2 * j] = projection.pixel_px.x();
+    projected_xy[2 * j + 1] = projection.pixel_px.y();
+    in_front[j] = projection.in_front;
+    pose_px[j] = {projection.pixel_px.x(), projection.pixel_px.y(),
+                  projection.in_front ? 1.0 : 0.0};
+  }
+  if (!pose_world_m.empty() && !frame.reference.empty()) {
+    const ReprojectionError error =
+        MeasureReprojection(projected_xy.data(), in_front.get(),
+                            frame.reference.data(), num_keypoints);
+    if (error.num_present > 0) rendered.e2d_px = error.mean_px;
+  }
+
+  // The reference is drawn wider, under the pose: where they agree the
+  // pose shows as a red core inside a green halo.
+  const OverlaySizes sizes = OverlaySizesForHeight(panel_height_px_);
+  OverlaySizes reference_sizes = sizes;
+  reference_sizes.line_width_px *= 2.2;
+  reference_sizes.dot_radius_px *= 1.6;
+  OverlayCanvas canvas(&rendered.image);
+  canvas.DrawSkeleton(*layout_, ScaleKeypoints(frame.reference, options_.scale),
+                      options_.reference_color, reference_sizes);
+  canvas.DrawSkeleton(*layout_, ScaleKeypoints(pose_px, options_.scale),
+                      options_.pose_color, sizes);
+  const double margin_px = 0.5 * sizes.font_size_px;
+  canvas.DrawLabel({{"frame " + std::to_string(frame.clip_frame)},
+                    {FormatE2d(rendered.e2d_px)},
+                    {options_.reference_label, options_.reference_color, true},
+                    {options_.pose_label, options_.pose_color, true}},
+                   margin_px, margin_px, sizes);
+  canvas.Finish();
+
+  if (options_.side_camera) {
+    const PinholeCamera side_camera = OrbitCamera(
+        options_.side, MeanPoint(pose_world_m, Eigen::Vector3d(0.0, 0.0, 1.0)),
+        panel_width_px_, panel_height_px_);
+    RgbImage side =
+        scene_->RenderPinhole(simulation_.mutable_data(), side_camera);
+    std::vector<Keypoint2D> side_pose_px;
+    for (const Eigen::Vector3d& point : pose_world_m) {
+      const Projection projection = side_camera.Project(point);
+      side_pose_px.push_back({projection.pixel_px.x(), projection.pixel_px.y(),
+                              projection.in_front ? 1.0 : 0.0});
+    }
+    OverlayCanvas side_canvas(&side);
+    side_canvas.DrawSkeleton(*layout_, side_pose_px, options_.pose_color,
+                             sizes);
+    side_canvas.DrawLabel({{"free camera"}}, margin_px, margin_px, sizes);
+    side_canvas.Finish();
+    RgbImage both(2 * panel_width_px_, panel_height_px_);
+    both.Paste(rendered.image, 0, 0);
+    both.Paste(side, panel_width_px_, 0);
+    rendered.image = std::move(both);
+  }
+  return rendered;
+}
+
+EpisodeSummary RenderEpisode(FrameSource& source, EpisodeRenderer& renderer,
+                             const EpisodeOutputOptions& output) {
+  output.Validate();
+  EpisodeSummary summary;
+  summary.width_px = renderer.width_px();
+  summary.height_px = renderer.height_px();
+  std::unique_ptr<Mp4Writer> video;
+  if (!output.video_path.empty()) {
+    video = std::make_unique<Mp4Writer>(output.video_path, summary.width_px,
+                                        summary.height_px, output.video);
+  }
+  if (!output.png_folder.empty()) {
+    std::filesystem::create_directories(output.png_folder);
+  }
+  double e2d_sum_px = 0.0;
+  int e2d_frames = 0;
+  EpisodeFrame frame;
+  int index = 0;
+  for (; source.Next(&frame); ++index) {
+    if (index < output.first_frame) continue;
+    if (output.last_frame >= 0 && index > output.last_frame) break;
+    RenderedFrame rendered = renderer.Render(frame);
+    if (video) video->Write(rendered.image);
+    if (!output.png_folder.empty()) {
+      std::string path =
+          (std::filesystem::path(output.png_folder) / PngName(frame.clip_frame))
+              .string();
+      WritePng(path, rendered.image);
+      summary.png_paths.push_back(path);
+    }
+    if (std::isfinite(rendered.e2d_px)) {
+      e2d_sum_px += rendered.e2d_px;
+      ++e2d_frames;
+    }
+    ++summary.frames_rendered;
+  }
+  if (summary.frames_rendered == 0) {
+    throw ConfigError("render: the frame range starts at frame " +
+                      std::to_string(output.first_frame) +
+                      " but the episode has " + std::to_string(index) +
+                      " frames");
+  }
+  if (e2d_frames > 0) summary.mean_e2d_px = e2d_sum_px / e2d_frames;
+  if (video) {
+    video->Finish();
+    summary.video_path = output.video_path;
+  }
+  return summary;
+}
+
+BundleReplaySource::BundleReplaySource(
+    const ReferenceBundle& bundle, int view_index,
+    std::shared_ptr<const Character> character,
+    const SimulationOptions& simulation)
+    : bundle_(bundle),
+      view_(bundle.views.at(view_index)),
+      simulation_(character, simulation) {
+  shows_character_ =
+      bundle.ground_truth && !bundle.ground_truth->poses.empty() &&
+      bundle.ground_truth->skeleton_name == character->skeleton().name;
+}
+
+bool BundleReplaySource::Next(EpisodeFrame* frame) {
+  const int t = next_frame_;
+  if (t >= bundle_.num_frames()) return false;
+  ++next_frame_;
+  frame->clip_frame = t;
+  frame->camera = view_.CameraAt(t);
+  const Clip2D& clip = view_.clip;
+  frame->reference.assign(
+      clip.keypoints.frame(t),
+      clip.keypoints.frame(t) + clip.keypoints.num_keypoints());
+  frame->keypoints_world_m.clear();
+  if (shows_character_) {
+    simulation_.SetPose(bundle_.ground_truth->poses[t]);
+    if (!frame->state) frame->state.emplace();
+    simulation_.Save(&*frame->state);
+  } else {
+    frame->state.reset();
+    // Ground-truth keypoints are drawn only in the clip's own layout.
+    if (bundle_.ground_truth && bundle_.ground_truth->layout == clip.layout &&
+        !bundle_.ground_truth->keypoints_m.empty()) {
+      frame->keypoints_world_m = bundle_.ground_truth->keypoints_m[t];
+    }
+  }
+  return true;
+}
+
+EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
+                                  const BundleReplayOptions& options) {
+  if (bundle.views.empty())
+    throw InputError(bundle.name, "bundle has no views");
+  int view_index = 0;
+  if (!options.view.empty()) {
+    view_index = -1;
+    std::string names;
+    for (size_t v = 0; v < bundle.views.size(); ++v) {
+      if (bundle.views[v].name == options.view)
+        view_index = static_cast<int>(v);
+      names += (names.empty() ? "" : ", ") + bundle.views[v].name;
+    }
+    if (view_index < 0) {
+      throw InputError(bundle.name,
+                       "no view '" + options.view + "' (views: " + names + ")");
+    }
+  }
+  const SimulationOptions simulation;
+  std::shared_ptr<const Character> character = LoadCharacterForSimulation(
+      options.character_config, options.scene, simulation);
+  BundleReplaySource source(bundle, view_index, character, simulation);
+  EpisodeRenderOptions render = options.render;
+  if (!source.shows_character()) render.pose_label = "3D ground truth";
+  const Clip2D& clip = bundle.views[view_index].clip;
+  EpisodeRenderer renderer(character, simulation, *clip.layout,
+                           clip.image_width_px, clip.image_height_px, render);
+  EpisodeOutputOptions output = options.output;
+  output.video.fps = bundle.fps;
+  return RenderEpisode(source, renderer, output);
+}
+
+}  // namespace m2d

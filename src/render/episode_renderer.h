@@ -1,0 +1,181 @@
+// render: what happened, shown — offscreen MuJoCo video from a reference
+// camera with 2D keypoint overlays, training plots and HTML reports.
+#ifndef MIMIC2D_RENDER_EPISODE_RENDERER_H_
+#define MIMIC2D_RENDER_EPISODE_RENDERER_H_
+
+#include <Eigen/Core>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera/pinhole.h"
+#include "motion/bundle.h"
+#include "motion/clip2d.h"
+#include "render/gl_camera.h"
+#include "render/image.h"
+#include "render/scene_renderer.h"
+#include "render/video_writer.h"
+#include "sim/simulation.h"
+
+namespace m2d {
+
+// One moment of an episode to show: the scene, the camera the reference
+// was seen from, and the 2D reference at that moment.
+struct EpisodeFrame {
+  int clip_frame = 0;    // reference clip frame, printed in the corner
+  PinholeCamera camera;  // at the clip's image size (scaling comes later)
+  // The layout's keypoints in the clip's image pixels; empty: no reference.
+  std::vector<Keypoint2D> reference;
+  // The character's (and the scene's) state; nullopt: the scene without
+  // the character.
+  std::optional<SimState> state;
+  // With no `state`: the shown pose's 3D keypoints (layout order, world),
+  // e.g. a bundle's ground truth for a skeleton without a character. With a
+  // `state` the character's keypoint sites are used and this is ignored.
+  std::vector<Eigen::Vector3d> keypoints_world_m;
+};
+
+// Where frames come from: a kinematic replay (BundleReplaySource), a policy
+// rollout, or any recorded sequence (RecordedFrames).
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // Fills the next frame; false when the episode is over.
+  virtual bool Next(EpisodeFrame* frame) = 0;
+};
+
+// Frames recorded beforehand (e.g. Simulation::Save() after every step of
+// a rollout), played in order.
+class RecordedFrames : public FrameSource {
+ public:
+  explicit RecordedFrames(std::vector<EpisodeFrame> frames)
+      : frames_(std::move(frames)) {}
+  bool Next(EpisodeFrame* frame) override;
+
+ private:
+  std::vector<EpisodeFrame> frames_;
+  size_t next_ = 0;
+};
+
+// How a frame looks.
+struct EpisodeRenderOptions {
+  // Output size = the clip's image size x scale, rounded up to even.
+  double scale = 1.0;
+  // A second panel on the right: an orbit camera following the pose's
+  // centre, with the pose's keypoints drawn (the reference has no meaning
+  // in that view).
+  bool side_camera = false;
+  OrbitCameraOptions side;
+  bool shadows = true;
+  Rgb reference_color = {40, 200, 70};  // green: the 2D reference
+  Rgb pose_color = {230, 50, 40};       // red: the shown pose, projected
+  std::string reference_label = "2D reference";
+  std::string pose_label = "character";
+  void Validate() const;  // throws ConfigError
+};
+
+// One drawn frame and the 2D error it shows.
+struct RenderedFrame {
+  RgbImage image;
+  // Mean distance (clip pixels) between the reference and the projected
+  // pose over the reference's present keypoints; NaN when not measurable.
+  double e2d_px = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Draws episode frames: the 3D scene through the frame's pinhole camera,
+// then the reference (green) and the pose's projected keypoints (red) as
+// skeletons, the frame number and 2D error in the top-left corner, and
+// optionally a free (orbit) camera panel on the right.
+class EpisodeRenderer {
+ public:
+  // Frames show `character`'s scene; their states are restored into the
+  // renderer's own simulation (the caller's is never touched). `layout`
+  // is the references' keypoint layout and must be the character's.
+  EpisodeRenderer(std::shared_ptr<const Character> character,
+                  const SimulationOptions& simulation,
+                  const KeypointLayout& layout, int image_width_px,
+                  int image_height_px, const EpisodeRenderOptions& options);
+
+  RenderedFrame Render(const EpisodeFrame& frame);
+
+  // Output frame size (both panels).
+  int width_px() const;
+  int height_px() const;
+  const EpisodeRenderOptions& options() const { return options_; }
+
+ private:
+  // The pose's 3D keypoints: restores the state (or hides the character).
+  std::vector<Eigen::Vector3d> PlaceScene(const EpisodeFrame& frame);
+
+  std::shared_ptr<const Character> character_;
+  const KeypointLayout* layout_;
+  EpisodeRenderOptions options_;
+  Simulation simulation_;
+  int image_width_px_;  // the clip's image size
+  int image_height_px_;
+  int panel_width_px_;  // one panel of the output, after scaling
+  int panel_height_px_;
+  std::unique_ptr<SceneRenderer> scene_;
+};
+
+// What to write and which frames.
+struct EpisodeOutputOptions {
+  std::string video_path;  // MP4; empty: no video
+  std::string png_folder;  // frame_<clip frame>.png; empty: no PNGs
+  Mp4Options video;
+  int first_frame = 0;    // the source's frames [first, last] are drawn,
+  int last_frame = -1;    // counted from 0 in source order; -1: to the end
+  void Validate() const;  // throws ConfigError
+};
+
+struct EpisodeSummary {
+  int frames_rendered = 0;
+  int width_px = 0;
+  int height_px = 0;
+  double mean_e2d_px = std::numeric_limits<double>::quiet_NaN();
+  std::string video_path;
+  std::vector<std::string> png_paths;
+};
+
+// Draws the source's frames in the range and writes the video and PNGs.
+EpisodeSummary RenderEpisode(FrameSource& source, EpisodeRenderer& renderer,
+                             const EpisodeOutputOptions& output);
+
+// Kinematic replay of a bundle view: each frame puts the character in the
+// ground-truth pose when the bundle's poses belong to the character's
+// skeleton; otherwise the scene is drawn without the character and the
+// ground-truth 3D keypoints (if any) are projected instead.
+class BundleReplaySource : public FrameSource {
+ public:
+  BundleReplaySource(const ReferenceBundle& bundle, int view_index,
+                     std::shared_ptr<const Character> character,
+                     const SimulationOptions& simulation);
+  bool Next(EpisodeFrame* frame) override;
+  bool shows_character() const { return shows_character_; }
+
+ private:
+  const ReferenceBundle& bundle_;
+  const ReferenceView& view_;
+  Simulation simulation_;
+  bool shows_character_ = false;
+  int next_frame_ = 0;
+};
+
+struct BundleReplayOptions {
+  std::string character_config;  // e.g. assets/characters/humanoid.yaml
+  std::string scene = "flat";
+  std::string view;  // view name; empty: the first view
+  EpisodeRenderOptions render;
+  EpisodeOutputOptions output;
+};
+
+// Replays `bundle` kinematically (BundleReplaySource) and writes the
+// outputs; the one call for `mimic2d render` and the demo.
+EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
+                                  const BundleReplayOptions& options);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_RENDER_EPISODE_RENDERER_H_

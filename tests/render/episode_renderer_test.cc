@@ -1,0 +1,210 @@
+#include "render/episode_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "common/error.h"
+#include "env/env_fixture.h"
+#include "render_test_util.h"
+
+namespace m2d {
+namespace {
+
+constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
+
+// The humanoid in its reference pose, seen by a 640x480 camera.
+class EpisodeFrameTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    character_ = testing::LoadRenderHumanoid();
+    Simulation simulation(character_, SimulationOptions());
+    state_ = simulation.Save();
+    std::vector<double> xyz(3 * character_->keypoint_sites().size());
+    simulation.KeypointPositions(xyz.data());
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    for (size_t j = 0; j < xyz.size() / 3; ++j) {
+      keypoints_m_.emplace_back(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
+      center += keypoints_m_.back();
+    }
+    center /= keypoints_m_.size();
+    Intrinsics intrinsics;
+    intrinsics.width_px = 640;
+    intrinsics.height_px = 480;
+    intrinsics.fx_px = intrinsics.fy_px = 600.0;
+    intrinsics.cx_px = 330.0;
+    intrinsics.cy_px = 250.0;
+    camera_ = PinholeCamera::LookAt(
+        intrinsics, center + Eigen::Vector3d(3.0, 1.5, 0.4), center);
+  }
+
+  // The pose's keypoints projected, shifted by `shift_px` horizontally.
+  std::vector<Keypoint2D> Projected(double shift_px) const {
+    std::vector<Keypoint2D> points;
+    for (const Eigen::Vector3d& keypoint : keypoints_m_) {
+      const Eigen::Vector2d pixel = camera_.Project(keypoint).pixel_px;
+      points.push_back({pixel.x() + shift_px, pixel.y(), 1.0});
+    }
+    return points;
+  }
+
+  std::shared_ptr<const Character> character_;
+  SimState state_;
+  std::vector<Eigen::Vector3d> keypoints_m_;
+  PinholeCamera camera_;
+};
+
+TEST_F(EpisodeFrameTest, OverlaysLandOnTheProjectedAndReferencePixels) {
+  EpisodeRenderOptions options;
+  options.scale = 0.5;
+  EpisodeRenderer renderer(character_, SimulationOptions(),
+                           character_->keypoint_layout(), 640, 480, options);
+  EXPECT_EQ(renderer.width_px(), 320);
+  EXPECT_EQ(renderer.height_px(), 240);
+
+  // The character with a reference 30 px (clip pixels) to its right.
+  EpisodeFrame frame;
+  frame.clip_frame = 7;
+  frame.camera = camera_;
+  frame.state = state_;
+  frame.reference = Projected(30.0);
+  const RenderedFrame rendered = renderer.Render(frame);
+  ASSERT_EQ(rendered.image.width_px(), 320);
+  EXPECT_NEAR(rendered.e2d_px, 30.0, 1e-9);
+  // Every projected keypoint's pixel (at half scale) is the pose colour,
+  // drawn over the 3D render and the reference.
+  for (const Keypoint2D& point : Projected(0.0)) {
+    EXPECT_EQ(rendered.image.at(static_cast<int>(std::floor(0.5 * point.x_px)),
+                                static_cast<int>(std::floor(0.5 * point.y_px))),
+              options.pose_color);
+  }
+
+  // Without a pose, the reference alone is drawn, at its pixels.
+  EpisodeFrame reference_only = frame;
+  reference_only.state.reset();
+  const RenderedFrame drawn = renderer.Render(reference_only);
+  EXPECT_TRUE(std::isnan(drawn.e2d_px));
+  for (const Keypoint2D& point : frame.reference) {
+    EXPECT_EQ(drawn.image.at(static_cast<int>(std::floor(0.5 * point.x_px)),
+                             static_cast<int>(std::floor(0.5 * point.y_px))),
+              options.reference_color);
+  }
+}
+
+TEST_F(EpisodeFrameTest, SideCameraDoublesTheWidth) {
+  EpisodeRenderOptions options;
+  options.scale = 0.5;
+  options.side_camera = true;
+  EpisodeRenderer renderer(character_, SimulationOptions(),
+                           character_->keypoint_layout(), 640, 480, options);
+  EpisodeFrame frame;
+  frame.camera = camera_;
+  frame.state = state_;
+  const RenderedFrame rendered = renderer.Render(frame);
+  EXPECT_EQ(rendered.image.width_px(), 640);
+  EXPECT_EQ(rendered.image.height_px(), 240);
+  // The right panel is the orbit camera around the pose's centre, with the
+  // pose's keypoints drawn where that camera projects them.
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& keypoint : keypoints_m_) center += keypoint;
+  const PinholeCamera side =
+      OrbitCamera(options.side, center / keypoints_m_.size(), 320, 240);
+  for (const Eigen::Vector3d& keypoint : keypoints_m_) {
+    const Eigen::Vector2d pixel = side.Project(keypoint).pixel_px;
+    EXPECT_EQ(rendered.image.at(320 + static_cast<int>(std::floor(pixel.x())),
+                                static_cast<int>(std::floor(pixel.y()))),
+              options.pose_color);
+  }
+}
+
+TEST_F(EpisodeFrameTest, MismatchedFramesAreInputErrors) {
+  EpisodeRenderer renderer(character_, SimulationOptions(),
+                           character_->keypoint_layout(), 640, 480,
+                           EpisodeRenderOptions());
+  EpisodeFrame frame;
+  frame.camera = camera_;
+  frame.state = state_;
+  frame.reference = Projected(0.0);
+  frame.reference.pop_back();
+  EXPECT_THROW(renderer.Render(frame), InputError);
+  EpisodeRenderer wrong_size(character_, SimulationOptions(),
+                             character_->keypoint_layout(), 1920, 1080,
+                             EpisodeRenderOptions());
+  frame.reference.clear();
+  EXPECT_THROW(wrong_size.Render(frame), InputError);
+}
+
+TEST(BundleReplay, WalkVideoPngsAndFrameRange) {
+  M2D_REQUIRE_SHARED(motion_path, kWalk);
+  auto character = testing::LoadRenderHumanoid();
+  const ReferenceBundle bundle =
+      testing::MakeWalkBundle(motion_path, *character, 1.0);
+  const std::string folder = testing::TempDir("bundle_replay");
+  BundleReplayOptions options;
+  options.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  options.view = bundle.views[1].name;
+  options.render.scale = 0.25;
+  options.render.side_camera = true;
+  options.output.video_path = folder + "/walk.mp4";
+  options.output.png_folder = folder + "/frames";
+  options.output.first_frame = 3;
+  options.output.last_frame = 12;
+  const EpisodeSummary summary = RenderBundleReplay(bundle, options);
+
+  EXPECT_EQ(summary.frames_rendered, 10);
+  EXPECT_EQ(summary.width_px, 960);  // two 480x270 panels
+  EXPECT_EQ(summary.height_px, 270);
+  // Ground truth replayed: the character's keypoints are the reference.
+  EXPECT_LT(summary.mean_e2d_px, 1.0);
+
+  const testing::VideoInfo video = testing::ProbeVideo(summary.video_path);
+  EXPECT_EQ(video.frames, 10);
+  EXPECT_EQ(video.width_px, 960);
+  EXPECT_EQ(video.height_px, 270);
+  ASSERT_EQ(summary.png_paths.size(), 10u);
+  EXPECT_EQ(std::filesystem::path(summary.png_paths.front()).filename(),
+            "frame_000003.png");
+  EXPECT_EQ(std::filesystem::path(summary.png_paths.back()).filename(),
+            "frame_000012.png");
+  const testing::PngSize png = testing::ReadPngSize(summary.png_paths[4]);
+  EXPECT_EQ(png.width_px, 960);
+  EXPECT_EQ(png.height_px, 270);
+
+  options.view = "no such view";
+  EXPECT_THROW(RenderBundleReplay(bundle, options), InputError);
+  options.view.clear();
+  options.output.first_frame = 40;
+  options.output.last_frame = -1;
+  EXPECT_THROW(RenderBundleReplay(bundle, options), ConfigError);
+}
+
+TEST(BundleReplay, SkeletonWithoutCharacterShowsTheGroundTruth) {
+  M2D_REQUIRE_SHARED(motion_path, kWalk);
+  auto character = testing::LoadRenderHumanoid();
+  ReferenceBundle bundle =
+      testing::MakeWalkBundle(motion_path, *character, 0.5);
+  bundle.ground_truth->skeleton_name = "a skeleton with no character";
+  BundleReplaySource source(bundle, 0, character, SimulationOptions());
+  EXPECT_FALSE(source.shows_character());
+  EpisodeFrame frame;
+  ASSERT_TRUE(source.Next(&frame));
+  EXPECT_FALSE(frame.state.has_value());
+  EXPECT_EQ(frame.keypoints_world_m.size(), 17u);
+
+  BundleReplayOptions options;
+  options.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  options.render.scale = 0.25;
+  options.output.video_path = testing::TempDir("truth_replay") + "/truth.mp4";
+  options.output.last_frame = 4;
+  const EpisodeSummary summary = RenderBundleReplay(bundle, options);
+  EXPECT_EQ(summary.frames_rendered, 5);
+  // The reference is the ground truth's exact projection.
+  EXPECT_LT(summary.mean_e2d_px, 1e-6);
+  EXPECT_EQ(testing::ProbeVideo(summary.video_path).frames, 5);
+}
+
+}  // namespace
+}  // namespace m2d
