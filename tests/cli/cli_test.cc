@@ -1,0 +1,156 @@
+// End-to-end checks of the `mimic2d` binary: real commands on real files,
+// and every kind of bad input ending in a clear message and exit code 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "motion/bundle.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult RunMimic2d(const std::string& arguments) {
+  std::string command = std::string(MIMIC2D_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (fgets(buffer, sizeof(buffer), pipe) != nullptr)
+    result.output += buffer;
+  int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string WriteFile(const std::string& dir, const std::string& name,
+                      const std::string& text) {
+  std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Cli, HelpListsTheSubcommands) {
+  CommandResult result = RunMimic2d("--help");
+  EXPECT_EQ(result.exit_code, 0);
+  for (const char* name :
+       {"clip", "train", "eval", "render", "plot", "report", "bench", "demo"}) {
+    EXPECT_NE(result.output.find(name), std::string::npos) << name;
+  }
+}
+
+TEST(Cli, FromMotionWalkGivesFourViewsEqualToTheProjectedTruth) {
+  M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
+  std::string dir = testing::TempDir("cli_walk");
+  std::string bundle_path = dir + "/walk.json";
+  CommandResult result =
+      RunMimic2d("clip from-motion " + walk + " --views 4 -o " + bundle_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ReferenceBundle bundle = ReadBundle(bundle_path);
+  ASSERT_EQ(bundle.views.size(), 4u);
+  double worst = 0.0;
+  for (const ReferenceView& view : bundle.views) {
+    for (int t = 0; t < bundle.num_frames(); ++t) {
+      for (int j = 0; j < 17; ++j) {
+        Projection p =
+            view.CameraAt(t).Project(bundle.ground_truth->keypoints_m[t][j]);
+        worst = std::max(
+            worst, (p.pixel_px - view.clip.keypoints.at(t, j).Pixel()).norm());
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_EQ(RunMimic2d("clip info " + bundle_path).exit_code, 0);
+}
+
+TEST(Cli, BvhDemoMotionBecomesABundle) {
+  const std::string bvh = "/usr/share/assimp/models/BVH/01_01.bvh";
+  if (!std::ifstream(bvh))
+    GTEST_SKIP() << bvh << " absent (Debian assimp-testmodels)";
+  std::string dir = testing::TempDir("cli_bvh");
+  CommandResult result = RunMimic2d(
+      "clip from-motion " + bvh + " --views 2 --follow -o " + dir + "/b.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(ReadBundle(dir + "/b.json").views.size(), 2u);
+}
+
+// Each bad input: exit code 2, one line naming the file and the problem.
+void ExpectInputError(const std::string& arguments, const std::string& file,
+                      const std::string& problem) {
+  CommandResult result = RunMimic2d(arguments);
+  EXPECT_EQ(result.exit_code, 2) << arguments << "\n" << result.output;
+  EXPECT_NE(result.output.find("error: "), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find(file), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find(problem), std::string::npos) << result.output;
+  EXPECT_EQ(result.output.find("terminate called"), std::string::npos)
+      << result.output;
+}
+
+TEST(Cli, BadInputIsAClearErrorNotACrash) {
+  std::string dir = testing::TempDir("cli_bad");
+  std::string malformed =
+      WriteFile(dir, "malformed.json", "{\"format\": \"mimic2d.clip\", ");
+  ExpectInputError("clip info " + malformed, malformed, "malformed JSON");
+
+  std::string layout = WriteFile(
+      dir, "layout.json",
+      R"({"format": "mimic2d.clip", "version": 1, "layout": "coco99", "fps": 30,
+          "image_width_px": 100, "image_height_px": 100, "keypoints": [[[1, 2, 1]]]})");
+  ExpectInputError("clip info " + layout, layout, "coco99");
+
+  std::string nan_point = WriteFile(
+      dir, "nan.json",
+      R"({"format": "mimic2d.clip", "version": 1, "layout": "point", "fps": 30,
+          "image_width_px": 100, "image_height_px": 100, "keypoints": [[[null, 2, 0.9]]]})");
+  ExpectInputError("clip info " + nan_point, nan_point, "frame 0");
+
+  std::string empty = WriteFile(
+      dir, "empty.json",
+      R"({"format": "mimic2d.clip", "version": 1, "layout": "coco17", "fps": 30,
+          "image_width_px": 100, "image_height_px": 100, "keypoints": []})");
+  ExpectInputError("clip info " + empty, empty, "no frames");
+
+  std::string shape = WriteFile(
+      dir, "shape.json",
+      R"({"format": "mimic2d.clip", "version": 1, "layout": "point", "fps": 30,
+          "image_width_px": 100, "image_height_px": 100, "keypoints": [[[1, 2, 1], [3, 4, 1]]]})");
+  ExpectInputError("clip info " + shape, shape, "2 keypoints");
+
+  std::string short_bvh =
+      WriteFile(dir, "short.bvh",
+                "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 "
+                "Xposition Yposition Zposition "
+                "Zrotation Yrotation Xrotation\n  End Site\n  {\n    OFFSET 0 "
+                "1 0\n  }\n}\nMOTION\n"
+                "Frames: 2\nFrame Time: 0.0333\n0 0 0 0 0 0\n0 0 0 0\n");
+  ExpectInputError("clip from-motion " + short_bvh + " -o " + dir + "/out.json",
+                   short_bvh, "frame");
+
+  std::string motion = WriteFile(
+      dir, "motion.txt", "{\"Loop\": \"wrap\", \"Frames\": [[0.03, 0, 1]]}");
+  ExpectInputError("clip from-motion " + motion + " -o " + dir + "/out.json",
+                   motion, "needs 44");
+
+  ExpectInputError("clip info " + dir + "/absent.json", dir + "/absent.json",
+                   "cannot open");
+  EXPECT_FALSE(
+      std::ifstream(dir + "/out.json").good());  // nothing half-written
+}
+
+TEST(Cli, BadSettingsAreRejected) {
+  M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
+  CommandResult result =
+      RunMimic2d("clip from-motion " + walk + " --views 0 -o /tmp/never.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("num_views"), std::string::npos)
+      << result.output;
+}
+
+}  // namespace
+}  // namespace m2d
