@@ -47,7 +47,7 @@ void VecEnv::Reset() {
 void VecEnv::Step(std::vector<FinishedEpisode>* finished) {
   const int count = num_envs();
   // Each environment writes only its own rows, so no locking is needed.
-#pragma omp parallel for schedule(static) num_threads(num_threads_)
+#pragma omp parallel for schedule(runtime) num_threads(num_threads_)
   for (int i = 0; i < count; ++i) {
     float* observation =
         observations_.data() + static_cast<size_t>(i) * observation_size_;
