@@ -1,0 +1,49 @@
+#include "render/policy_rollout.h"
+
+namespace m2d {
+namespace {
+
+EpisodeFrame CurrentFrame(const TrackingEnv& env,
+                          const TrackingReference& reference) {
+  const TrackedView& view = env.view();
+  const ReferenceBundle& bundle = reference.bundles()[view.bundle];
+  const int num_keypoints =
+      env.simulation().character().keypoint_layout().num_keypoints();
+  EpisodeFrame frame;
+  frame.clip_frame = env.frame();
+  frame.camera = bundle.views[view.view].CameraAt(env.frame());
+  const Keypoint2D* points = view.frame(env.frame());
+  frame.reference.assign(points, points + num_keypoints);
+  frame.state = env.simulation().Save();
+  return frame;
+}
+
+}  // namespace
+
+std::vector<EpisodeFrame> RecordPolicyRollout(
+    Policy& policy, TrackingEnv& env, const TrackingReference& reference,
+    const InitialStates& initial_states, int view_index, int start_frame) {
+  const StateBuffer& buffer =
+      initial_states.buffer(reference.views()[view_index].bundle);
+  int best = 0;
+  for (int i = 1; i < buffer.size(start_frame); ++i) {
+    if (buffer.entry(start_frame, i).score >
+        buffer.entry(start_frame, best).score)
+      best = i;
+  }
+  std::vector<float> observation(env.observation_size()),
+      action(env.action_size());
+  env.ResetTo(view_index, start_frame, buffer.entry(start_frame, best).state,
+              observation.data());
+  std::vector<EpisodeFrame> frames = {CurrentFrame(env, reference)};
+  for (;;) {
+    policy.Act(observation.data(), 1, action.data());
+    StepOutcome outcome = env.Step(action.data(), observation.data());
+    if (outcome.diverged) break;
+    frames.push_back(CurrentFrame(env, reference));
+    if (outcome.terminated || outcome.truncated) break;
+  }
+  return frames;
+}
+
+}  // namespace m2d
