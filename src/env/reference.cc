@@ -23,16 +23,6 @@ void RootAndScale3D(const std::vector<Eigen::Vector3d>& keypoints,
   *scale_m = std::sqrt(squared / keypoints.size());
 }
 
-std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
-  int count = simulation.character().keypoint_layout().num_keypoints();
-  std::vector<double> xyz(3 * count);
-  simulation.KeypointPositions(xyz.data());
-  std::vector<Eigen::Vector3d> points(count);
-  for (int j = 0; j < count; ++j)
-    points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
-  return points;
-}
-
 // The model's default pose, turned to face the camera and moved so that its
 // root keypoints project onto the 2D root, at the height they have standing.
 Pose3D PlaceDefaultPose(const Character& character, const Pose3D& standing,

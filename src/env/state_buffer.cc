@@ -39,6 +39,15 @@ void StateBuffer::Rescore(int frame, int index, double score) {
   entries_[frame][index].score = score;
 }
 
+int StateBuffer::Best(int frame) const {
+  const std::vector<ScoredState>& slot = entries_[frame];
+  int best = slot.empty() ? -1 : 0;
+  for (int i = 1; i < static_cast<int>(slot.size()); ++i) {
+    if (slot[i].score > slot[best].score) best = i;
+  }
+  return best;
+}
+
 int StateBuffer::Sample(int frame, std::mt19937_64& rng) const {
   const std::vector<ScoredState>& slot = entries_[frame];
   if (slot.empty()) return -1;

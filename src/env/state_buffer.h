@@ -45,6 +45,9 @@ class StateBuffer {
   bool Insert(int frame, const SimState& state, double score);
   void Rescore(int frame, int index, double score);
 
+  // The index of `frame`'s highest-scoring entry; -1 when empty.
+  int Best(int frame) const;
+
   // An entry index of `frame`, drawn with probability ∝ exp(score / T);
   // -1 when the frame is empty.
   int Sample(int frame, std::mt19937_64& rng) const;

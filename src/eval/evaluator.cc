@@ -7,28 +7,7 @@
 #include "eval/metrics.h"
 
 namespace m2d {
-namespace {
-
-std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
-  const int count = simulation.character().keypoint_layout().num_keypoints();
-  std::vector<double> xyz(3 * count);
-  simulation.KeypointPositions(xyz.data());
-  std::vector<Eigen::Vector3d> points(count);
-  for (int j = 0; j < count; ++j)
-    points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
-  return points;
-}
-
-int BestEntry(const StateBuffer& buffer, int frame) {
-  int best = 0;
-  for (int i = 1; i < buffer.size(frame); ++i) {
-    if (buffer.entry(frame, i).score > buffer.entry(frame, best).score)
-      best = i;
-  }
-  return best;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void EvalOptions::Validate() const {
   if (episodes_per_view < 1)
@@ -84,7 +63,7 @@ std::vector<EvalRow> EvaluatePolicy(
                       : last_start * e / (options.episodes_per_view - 1);
       const StateBuffer& buffer = initial_states->buffer(view.bundle);
       env.ResetTo(static_cast<int>(v), start,
-                  buffer.entry(start, BestEntry(buffer, start)).state,
+                  buffer.entry(start, buffer.Best(start)).state,
                   observation.data());
       KeypointFrames simulated, truth;
       double object_error = 0.0;

@@ -25,12 +25,7 @@ std::vector<EpisodeFrame> RecordPolicyRollout(
     const InitialStates& initial_states, int view_index, int start_frame) {
   const StateBuffer& buffer =
       initial_states.buffer(reference.views()[view_index].bundle);
-  int best = 0;
-  for (int i = 1; i < buffer.size(start_frame); ++i) {
-    if (buffer.entry(start_frame, i).score >
-        buffer.entry(start_frame, best).score)
-      best = i;
-  }
+  const int best = buffer.Best(start_frame);
   std::vector<float> observation(env.observation_size()),
       action(env.action_size());
   env.ResetTo(view_index, start_frame, buffer.entry(start_frame, best).state,

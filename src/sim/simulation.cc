@@ -339,4 +339,14 @@ bool Simulation::UnexpectedGroundContact() const {
   return false;
 }
 
+std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
+  const int count = simulation.character().keypoint_layout().num_keypoints();
+  std::vector<double> xyz(3 * count);
+  simulation.KeypointPositions(xyz.data());
+  std::vector<Eigen::Vector3d> points(count);
+  for (int j = 0; j < count; ++j)
+    points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
+  return points;
+}
+
 }  // namespace m2d

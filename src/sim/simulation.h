@@ -132,6 +132,9 @@ class Simulation {
   std::vector<uint8_t> allowed_ground_;  // per body
 };
 
+// The keypoint sites' world positions as points (layout order).
+std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_SIM_SIMULATION_H_
