@@ -222,6 +222,8 @@ BENCHMARK(BM_VecEnvStep)
     ->ArgNames({"envs", "threads"})
     ->Args({16, 1})
     ->Args({16, 2})
+    ->Args({64, 1})
+    ->Args({64, 2})
     ->UseRealTime();
 
 }  // namespace

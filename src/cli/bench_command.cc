@@ -179,10 +179,11 @@ Task MakeTask(const BenchEnvOptions& options) {
   std::vector<ReferenceBundle> bundles;
   bundles.push_back(MakeBundleFromMotion(motion, task.character->keypoint_map(),
                                          bundle_options, name));
-  task.description = have_motion
-                         ? name + " (" + options.motion + ")"
-                         : "shared motion data absent (" + options.motion +
-                               "): tracking the default standing pose instead";
+  task.description =
+      have_motion ? name + " (" + options.motion + ")"
+                  : "the default standing pose held still (shared motion "
+                    "data absent: " +
+                        options.motion + ")";
   task.reference = TrackingReference::Prepare(
       std::move(bundles), *task.character, task.options.simulation.control_hz);
   task.initial_states = std::make_shared<InitialStates>(
@@ -200,10 +201,11 @@ struct Workload {
   int warmup_steps = 0;
   int action_size = 0;
   int observation_size = 0;
-  std::vector<float> actions;            // steps x envs x action_size
-  std::vector<SimState> start_states;    // per world, after VecEnv::Reset
-  std::vector<int> restart_index;        // steps x envs: into restart_states
-  std::vector<SimState> restart_states;  // or -1: no restart after the step
+  std::vector<float> actions;          // steps x envs x action_size
+  std::vector<SimState> start_states;  // per world, after VecEnv::Reset
+  // Steps x envs: index into restart_states, -1 if no restart followed.
+  std::vector<int> restart_index;
+  std::vector<SimState> restart_states;
 
   const float* action(int step, int env) const {
     return actions.data() +
@@ -316,6 +318,19 @@ struct PhysicsWorld {
   std::vector<double> targets_rad;
 };
 
+// The workload's worlds in their start states.
+std::vector<PhysicsWorld> MakeWorlds(const Task& task,
+                                     const Workload& workload) {
+  std::vector<PhysicsWorld> worlds(workload.num_envs);
+  for (int i = 0; i < workload.num_envs; ++i) {
+    worlds[i].sim =
+        std::make_unique<Simulation>(task.character, task.options.simulation);
+    worlds[i].sim->Restore(workload.start_states[i]);
+    worlds[i].targets_rad.resize(task.character->num_actions());
+  }
+  return worlds;
+}
+
 // One control step of world `i`, then its restart if the environment
 // restarted it after this step.
 void StepWorld(const Task& task, const Workload& workload, PhysicsLoop loop,
@@ -346,13 +361,7 @@ void StepWorld(const Task& task, const Workload& workload, PhysicsLoop loop,
 RunResult RunPhysics(const Task& task, const Workload& workload,
                      PhysicsLoop loop, int threads) {
   const int num_worlds = workload.num_envs;
-  std::vector<PhysicsWorld> worlds(num_worlds);
-  for (int i = 0; i < num_worlds; ++i) {
-    worlds[i].sim =
-        std::make_unique<Simulation>(task.character, task.options.simulation);
-    worlds[i].sim->Restore(workload.start_states[i]);
-    worlds[i].targets_rad.resize(task.character->num_actions());
-  }
+  std::vector<PhysicsWorld> worlds = MakeWorlds(task, workload);
   // Warm-up (and, but for free running, the timed steps) in lockstep and
   // scheduled as VecEnv steps its environments.
   const int lockstep_end = loop == PhysicsLoop::kBareFreeRunning
@@ -378,6 +387,81 @@ RunResult RunPhysics(const Task& task, const Workload& workload,
   for (const PhysicsWorld& world : worlds)
     AppendQpos(*world.sim, &result.final_qpos);
   return result;
+}
+
+// How much a world's control step costs, and how evenly that lets a
+// lockstep loop (every thread waits for the others after each step) split
+// the worlds between threads.
+struct LoadBalance {
+  double mean_us = 0.0, cv = 0.0, p10_us = 0.0, p50_us = 0.0, p90_us = 0.0;
+  // Speedup over one thread if only the waiting cost anything.
+  double static_bound = 1.0;   // contiguous blocks of worlds per thread
+  double dynamic_bound = 1.0;  // next free thread takes the next world
+};
+
+// Per step, the time the slowest of `threads` threads needs for its share.
+double StaticMakespan(const double* costs, int num_worlds, int threads) {
+  const int block = (num_worlds + threads - 1) / threads;
+  double slowest = 0.0;
+  for (int start = 0; start < num_worlds; start += block) {
+    double sum = 0.0;
+    for (int i = start; i < std::min(num_worlds, start + block); ++i)
+      sum += costs[i];
+    slowest = std::max(slowest, sum);
+  }
+  return slowest;
+}
+
+double DynamicMakespan(const double* costs, int num_worlds, int threads) {
+  std::vector<double> busy_until(threads, 0.0);
+  for (int i = 0; i < num_worlds; ++i)
+    *std::min_element(busy_until.begin(), busy_until.end()) += costs[i];
+  return *std::max_element(busy_until.begin(), busy_until.end());
+}
+
+// `costs_s`: per step, one cost per world.
+LoadBalance SummarizeCosts(std::vector<double> costs_s, int num_worlds,
+                           int threads) {
+  LoadBalance balance;
+  double serial_s = 0.0, static_s = 0.0, dynamic_s = 0.0;
+  for (size_t row = 0; row < costs_s.size(); row += num_worlds) {
+    static_s += StaticMakespan(&costs_s[row], num_worlds, threads);
+    dynamic_s += DynamicMakespan(&costs_s[row], num_worlds, threads);
+  }
+  double squares = 0.0;
+  for (double cost : costs_s) {
+    serial_s += cost;
+    squares += cost * cost;
+  }
+  const double count = static_cast<double>(costs_s.size());
+  const double mean_s = serial_s / count;
+  balance.mean_us = 1e6 * mean_s;
+  balance.cv =
+      std::sqrt(std::max(0.0, squares / count - mean_s * mean_s)) / mean_s;
+  std::sort(costs_s.begin(), costs_s.end());
+  balance.p10_us = 1e6 * costs_s[costs_s.size() / 10];
+  balance.p50_us = 1e6 * costs_s[costs_s.size() / 2];
+  balance.p90_us = 1e6 * costs_s[costs_s.size() * 9 / 10];
+  balance.static_bound = serial_s / static_s;
+  balance.dynamic_bound = serial_s / dynamic_s;
+  return balance;
+}
+
+// Times every world's step of the bare-physics loop on one thread.
+LoadBalance MeasureLoadBalance(const Task& task, const Workload& workload,
+                               int threads) {
+  std::vector<PhysicsWorld> worlds = MakeWorlds(task, workload);
+  std::vector<double> costs_s;  // timed steps x worlds
+  for (int step = 0; step < workload.num_steps; ++step) {
+    for (int i = 0; i < workload.num_envs; ++i) {
+      const auto start = std::chrono::steady_clock::now();
+      StepWorld(task, workload, PhysicsLoop::kBareMjStep, step, i, &worlds[i]);
+      const std::chrono::duration<double> cost =
+          std::chrono::steady_clock::now() - start;
+      if (step >= workload.warmup_steps) costs_s.push_back(cost.count());
+    }
+  }
+  return SummarizeCosts(std::move(costs_s), workload.num_envs, threads);
 }
 
 double MaxAbsDifference(const std::vector<double>& a,
@@ -545,6 +629,18 @@ int RunBenchEnv(BenchEnvOptions options) {
     rows.push_back(env[t]);
   }
   PrintTable(rows);
+  if (options.threads_max > 1) {
+    LoadBalance balance =
+        MeasureLoadBalance(task, workload, options.threads_max);
+    std::printf(
+        "one world's control step (bare physics): mean %.0f us, cv %.2f, "
+        "p10 %.0f / p50 %.0f / p90 %.0f us\n"
+        "lockstep bound on the %d-thread speedup from that spread: static "
+        "schedule %.3f, dynamic %.3f (VecEnv's)\n\n",
+        balance.mean_us, balance.cv, balance.p10_us, balance.p50_us,
+        balance.p90_us, options.threads_max, balance.static_bound,
+        balance.dynamic_bound);
+  }
   const double ratio = env[0].Median() / bare[0].Median();
   std::printf(
       "env / bare physics, 1 thread        %5.3f  (target >= 0.85: "
@@ -567,6 +663,15 @@ int RunBenchEnv(BenchEnvOptions options) {
         "this work)\n",
         env_top.threads,
         free_running.back().Median() / free_running[0].Median());
+  }
+  for (const Series& series : env) {
+    if (series.threads > 1 && series.num_quiet() == 0) {
+      std::printf(
+          "warning: other processes shared the cores during every %d-thread "
+          "run, so its figures are not meaningful (docs/benchmarks.md, "
+          "\"Shared machines\")\n",
+          series.threads);
+    }
   }
   std::printf(
       "replay check: worlds end within %.3g of the environment's qpos "
