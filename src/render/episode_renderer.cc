@@ -119,13 +119,7 @@ std::vector<Eigen::Vector3d> EpisodeRenderer::PlaceScene(
   }
   scene_->SetHiddenBodies({});
   simulation_.Restore(*frame.state);
-  std::vector<double> xyz(3 * character_->keypoint_sites().size());
-  simulation_.KeypointPositions(xyz.data());
-  std::vector<Eigen::Vector3d> keypoints(xyz.size() / 3);
-  for (size_t j = 0; j < keypoints.size(); ++j) {
-    keypoints[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
-  }
-  return keypoints;
+  return SimulatedKeypoints(simulation_);
 }
 
 RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -40,9 +41,9 @@ void TrimLog(const std::string& path, int iteration) {
   std::string line;
   std::getline(in, line);  // header
   while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    if (std::stoi(line.substr(0, line.find(','))) <= iteration)
-      kept << line << "\n";
+    // Rows past the checkpoint, or torn by a kill mid-write, are dropped.
+    const int row_iteration = std::atoi(line.c_str());
+    if (row_iteration > 0 && row_iteration <= iteration) kept << line << "\n";
   }
   WriteFileAtomic(path, kept.str());
 }

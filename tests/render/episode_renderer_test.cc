@@ -21,14 +21,8 @@ class EpisodeFrameTest : public ::testing::Test {
     character_ = testing::LoadRenderHumanoid();
     Simulation simulation(character_, SimulationOptions());
     state_ = simulation.Save();
-    std::vector<double> xyz(3 * character_->keypoint_sites().size());
-    simulation.KeypointPositions(xyz.data());
-    Eigen::Vector3d center = Eigen::Vector3d::Zero();
-    for (size_t j = 0; j < xyz.size() / 3; ++j) {
-      keypoints_m_.emplace_back(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
-      center += keypoints_m_.back();
-    }
-    center /= keypoints_m_.size();
+    keypoints_m_ = SimulatedKeypoints(simulation);
+    const Eigen::Vector3d center = testing::Centroid(keypoints_m_);
     Intrinsics intrinsics;
     intrinsics.width_px = 640;
     intrinsics.height_px = 480;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "render/image.h"
 #include "render/subprocess.h"
@@ -22,6 +23,13 @@ inline std::shared_ptr<const Character> LoadRenderHumanoid() {
   return LoadCharacterForSimulation(
       SourcePath("assets/characters/humanoid.yaml"), "flat",
       SimulationOptions());
+}
+
+// Mean of a set of points (the look-at target of the test cameras).
+inline Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& point : points) sum += point;
+  return sum / static_cast<double>(points.size());
 }
 
 // Largest per-channel difference between two pixels.

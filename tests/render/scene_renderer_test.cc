@@ -52,14 +52,8 @@ class KnownPoseRender : public ::testing::Test {
           0.6 * (std::abs(low) > std::abs(high) ? low : high);
     }
     simulation_->Refresh();
-    std::vector<double> xyz(3 * character_->keypoint_sites().size());
-    simulation_->KeypointPositions(xyz.data());
-    Eigen::Vector3d center = Eigen::Vector3d::Zero();
-    for (size_t j = 0; j < xyz.size() / 3; ++j) {
-      keypoints_m_.emplace_back(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
-      center += keypoints_m_.back();
-    }
-    center /= keypoints_m_.size();
+    keypoints_m_ = SimulatedKeypoints(*simulation_);
+    const Eigen::Vector3d center = testing::Centroid(keypoints_m_);
     // Off-centre principal point: a frustum ignoring it misses by 60 px
     // horizontally and 50 px vertically.
     Intrinsics intrinsics;
