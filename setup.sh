@@ -12,6 +12,9 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # libqhull-dev: mujoco's CMake target names /usr/include/libqhull_r
   libmujoco-dev libqhull-dev libtorch-dev libceres-dev libassimp-dev assimp-testmodels
+  # libopenblas0-openmp: LibTorch's libblas.so.3; 4x faster PPO updates than
+  # ATLAS here, and it follows LibTorch's thread setting (docs/benchmarks.md)
+  libopenblas0-openmp
   # libcairo2-dev: overlays, PNG and text on rendered frames (brings glib)
   libosmesa6-dev libcairo2-dev ffmpeg gnuplot-nox
 )

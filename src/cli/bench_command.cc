@@ -725,6 +725,7 @@ void AddBenchCommand(CLI::App& app, CommandRun* run) {
       ->capture_default_str();
   env->callback(
       [run, options] { *run = [options] { return RunBenchEnv(*options); }; });
+  AddBenchTrainSubcommand(bench, run);
 }
 
 }  // namespace m2d::cli

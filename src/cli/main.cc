@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "common/blas_kernels.h"
 #include "common/error.h"
 
 namespace m2d::cli {
@@ -21,6 +22,8 @@ std::string AssetPath(const std::string& relative) {
 }  // namespace m2d::cli
 
 int main(int argc, char** argv) {
+  // May restart the program once, before anything else happens.
+  m2d::UseFastestBlasKernels(argv);
   CLI::App app{
       "mimic2d: learn physics-based character controllers from 2D keypoints"};
   app.require_subcommand(1);

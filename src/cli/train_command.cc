@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "common/blas_kernels.h"
 #include "rl/trainer.h"
 
 namespace m2d::cli {
@@ -40,6 +41,7 @@ int RunTrain(const TrainArgs& args) {
       args.config_path.c_str(), config.run.run_dir.c_str(), config.ppo.num_envs,
       config.ppo.steps_per_env,
       static_cast<long long>(config.run.total_samples));
+  std::printf("BLAS: %s\n", DescribeBlas().c_str());
   Trainer trainer(config, args.resume);
 
   // Ctrl-C / kill: finish the iteration, write a checkpoint, exit.

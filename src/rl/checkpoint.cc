@@ -154,13 +154,15 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
   torch::serialize::InputArchive archive = OpenArchive(path);
   CheckpointCounters counters;
   try {
-    torch::Tensor value;
-    archive.read("iteration", value);
-    counters.iteration = static_cast<int>(value.item<int64_t>());
-    archive.read("samples", value);
-    counters.samples = value.item<int64_t>();
-    archive.read("wall_time_s", value);
-    counters.wall_time_s = value.item<double>();
+    // A fresh tensor per read: reading into a defined tensor keeps its
+    // dtype and reinterprets the bytes (a double read as int64).
+    torch::Tensor iteration, samples, wall_time_s;
+    archive.read("iteration", iteration);
+    counters.iteration = static_cast<int>(iteration.item<int64_t>());
+    archive.read("samples", samples);
+    counters.samples = samples.item<int64_t>();
+    archive.read("wall_time_s", wall_time_s);
+    counters.wall_time_s = wall_time_s.item<double>();
     torch::serialize::InputArchive model_archive;
     archive.read("model", model_archive);
     model->load(model_archive);

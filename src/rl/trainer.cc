@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -129,6 +130,17 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
         run.seed + s.counters.iteration);
     spdlog::info("resumed from {} at iteration {} ({} samples)",
                  s.checkpoint_path, s.counters.iteration, s.counters.samples);
+    // A fixed sigma is a setting, not learned state: the config decides it
+    // (e.g. lowering exploration noise for the later part of a long run).
+    if (!config.model.learn_action_std) {
+      const double saved_std = s.model->LogStd().exp().mean().item<double>();
+      if (std::abs(saved_std - config.model.action_std) > 1e-9) {
+        spdlog::info("action_std {} -> {} (from the config)", saved_std,
+                     config.model.action_std);
+      }
+      torch::NoGradGuard no_grad;
+      s.model->LogStd().fill_(std::log(config.model.action_std));
+    }
     TrimLog(s.log_path, s.counters.iteration);
   } else {
     if (resume)

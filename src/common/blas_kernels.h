@@ -1,0 +1,37 @@
+// common: choice of the BLAS kernels LibTorch's matrix products run on.
+//
+// OpenBLAS (Debian's libopenblas0-*, selected as libblas.so.3) picks its
+// kernels from a table of CPU models when it loads. Virtual machines often
+// report a generic model ("Intel Xeon Processor"), and OpenBLAS then falls
+// back to its oldest SSE3 ("Prescott") kernels: the PPO update ran 4.4x
+// slower than with its AVX-512 kernels on the development machine
+// (docs/benchmarks.md). The override, OPENBLAS_CORETYPE, is only read at
+// load time, so it has to be set before the program starts.
+#ifndef MIMIC2D_COMMON_BLAS_KERNELS_H_
+#define MIMIC2D_COMMON_BLAS_KERNELS_H_
+
+#include <string>
+
+namespace m2d {
+
+// The OpenBLAS core type best suited to this CPU's instruction sets
+// ("SkylakeX" with AVX-512, "Haswell" with AVX2 + FMA), or "" when the
+// CPU has neither.
+std::string PreferredOpenBlasCore();
+
+// OpenBLAS's kernel choice in this process (e.g. "SkylakeX"), or "" when
+// the BLAS in use is not OpenBLAS.
+std::string LoadedOpenBlasCore();
+
+// Call first thing in main(). When OpenBLAS is the BLAS in use, chose
+// kernels weaker than PreferredOpenBlasCore(), and OPENBLAS_CORETYPE is
+// unset, re-executes the program once with OPENBLAS_CORETYPE set; returns
+// (doing nothing) otherwise, or if the re-execution fails.
+void UseFastestBlasKernels(char** argv);
+
+// One line for logs, e.g. "OpenBLAS (SkylakeX kernels)" or "not OpenBLAS".
+std::string DescribeBlas();
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_COMMON_BLAS_KERNELS_H_
