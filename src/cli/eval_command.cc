@@ -4,10 +4,7 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "common/file_io.h"
-#include "eval/evaluator.h"
-#include "motion/bundle.h"
-#include "rl/torch_policy.h"
+#include "cli/policy_runs.h"
 
 namespace m2d::cli {
 namespace {
@@ -19,68 +16,12 @@ struct EvalArgs {
   EvalOptions options;
 };
 
-std::string Cell(double value, const char* format) {
-  if (value < 0) return "-";
-  char text[32];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
-
-void PrintRow(const EvalRow& row) {
-  std::printf(
-      "%-22s %-7s %5d %7s %8s %8s %9s %11s %7s\n", row.bundle.c_str(),
-      row.view.c_str(), row.episodes, Cell(100 * row.succ, "%.1f").c_str(),
-      Cell(row.e2d_px, "%.1f").c_str(), Cell(row.eo2d_px, "%.1f").c_str(),
-      Cell(row.e3d_mm, "%.0f").c_str(), Cell(row.e3d_root_mm, "%.0f").c_str(),
-      Cell(row.jitter, "%.2f").c_str());
-}
-
-nlohmann::json RowToJson(const EvalRow& row) {
-  auto optional = [](double v) {
-    return v < 0 ? nlohmann::json() : nlohmann::json(v);
-  };
-  return {{"clip", row.bundle},
-          {"view", row.view},
-          {"episodes", row.episodes},
-          {"succ", row.succ},
-          {"e2d_px", row.e2d_px},
-          {"eo2d_px", optional(row.eo2d_px)},
-          {"e3d_mm", optional(row.e3d_mm)},
-          {"e3d_root_mm", optional(row.e3d_root_mm)},
-          {"jitter", row.jitter},
-          {"mean_frames", row.mean_frames}};
-}
-
 int RunEval(const EvalArgs& args) {
-  TorchPolicy policy(args.checkpoint);
-  const TrainConfig& config = policy.config();
-  std::vector<std::string> paths =
-      args.bundles.empty() ? config.data.bundles : args.bundles;
-  auto character = LoadCharacterForSimulation(
-      config.data.character_config, config.data.scene, config.env.simulation);
-  std::vector<ReferenceBundle> bundles;
-  for (const std::string& path : paths) bundles.push_back(ReadBundle(path));
-  auto reference = TrackingReference::Prepare(std::move(bundles), *character,
-                                              config.env.simulation.control_hz);
-  auto states = std::make_shared<InitialStates>(
-      *reference, character, config.env.simulation, StateBufferOptions());
-  std::vector<EvalRow> rows = EvaluatePolicy(policy, character, reference,
-                                             states, config.env, args.options);
-  std::printf("%-22s %-7s %5s %7s %8s %8s %9s %11s %7s\n", "clip", "view",
-              "eps", "Succ%", "E2D(px)", "EO2D(px)", "E3D(mm)", "E3Droot(mm)",
-              "Jitter");
-  for (const EvalRow& row : rows) PrintRow(row);
-  EvalRow all = AggregateRows(rows);
-  PrintRow(all);
+  std::vector<EvalRow> rows =
+      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options);
+  PrintEvalTable(rows);
   if (!args.output.empty()) {
-    nlohmann::json json = {
-        {"checkpoint", args.checkpoint},
-        {"episode_s", args.options.episode_s},
-        {"success_threshold_px", args.options.success_threshold_px},
-        {"rows", nlohmann::json::array()},
-        {"all", RowToJson(all)}};
-    for (const EvalRow& row : rows) json["rows"].push_back(RowToJson(row));
-    WriteJsonFileAtomic(args.output, json, 2);
+    WriteEvalJson(args.output, args.checkpoint, args.options, rows);
     std::printf("wrote %s\n", args.output.c_str());
   }
   return 0;

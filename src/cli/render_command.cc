@@ -6,12 +6,11 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/policy_runs.h"
 #include "common/error.h"
 #include "env/reference.h"
 #include "motion/bundle.h"
 #include "render/episode_renderer.h"
-#include "render/policy_rollout.h"
-#include "rl/torch_policy.h"
 
 namespace m2d::cli {
 namespace {
@@ -25,47 +24,14 @@ struct RenderArgs {
   double episode_s = 10.0;  // and last at most this long
 };
 
-// A policy rollout on the bundle's view, recorded and drawn.
-EpisodeSummary RenderPolicyRollout(const ReferenceBundle& bundle,
-                                   const RenderArgs& args) {
-  TorchPolicy policy(args.policy);
-  const TrainConfig& config = policy.config();
-  auto character = LoadCharacterForSimulation(
-      config.data.character_config, config.data.scene, config.env.simulation);
-  auto reference = TrackingReference::Prepare({bundle}, *character,
-                                              config.env.simulation.control_hz);
-  auto states = std::make_shared<InitialStates>(
-      *reference, character, config.env.simulation, StateBufferOptions());
-  int view_index = 0;
-  for (size_t v = 0; v < bundle.views.size(); ++v) {
-    if (bundle.views[v].name == args.replay.view)
-      view_index = static_cast<int>(v);
-  }
-  if (args.start_frame < 0 || args.start_frame >= bundle.num_frames() - 1) {
-    throw ConfigError("--start-frame must be in [0, " +
-                      std::to_string(bundle.num_frames() - 2) + "]");
-  }
-  TrackingEnvOptions env_options = config.env;
-  env_options.max_episode_s = args.episode_s;
-  env_options.initial_state_noise_rad = 0.0;
-  TrackingEnv env(character, reference, states, env_options, 0);
-  RecordedFrames frames(RecordPolicyRollout(policy, env, *reference, *states,
-                                            view_index, args.start_frame));
-  const Clip2D& clip = bundle.views[view_index].clip;
-  EpisodeRenderOptions render = args.replay.render;
-  render.pose_label = "character (policy)";
-  EpisodeRenderer renderer(character, config.env.simulation,
-                           character->keypoint_layout(), clip.image_width_px,
-                           clip.image_height_px, render);
-  return RenderEpisode(frames, renderer, args.replay.output);
-}
-
 int RunRender(RenderArgs& args) {
   args.replay.render.shadows = !args.no_shadows;
   const ReferenceBundle bundle = ReadBundle(args.bundle);
-  const EpisodeSummary summary = args.policy.empty()
-                                     ? RenderBundleReplay(bundle, args.replay)
-                                     : RenderPolicyRollout(bundle, args);
+  const EpisodeSummary summary =
+      args.policy.empty()
+          ? RenderBundleReplay(bundle, args.replay)
+          : RenderCheckpointRollout(args.policy, bundle, args.replay,
+                                    args.start_frame, args.episode_s);
   std::cout << "rendered " << summary.frames_rendered << " frames, "
             << summary.width_px << "x" << summary.height_px << " px";
   if (std::isfinite(summary.mean_e2d_px)) {

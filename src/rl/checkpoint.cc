@@ -99,7 +99,13 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
   }
 
   std::string temp = path + ".tmp." + std::to_string(::getpid());
-  archive.save_to(temp);
+  try {
+    archive.save_to(temp);
+  } catch (const c10::Error& e) {
+    std::remove(temp.c_str());  // a partly written file is no checkpoint
+    throw InputError(path, "cannot write checkpoint: " +
+                               std::string(e.what_without_backtrace()));
+  }
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::remove(temp.c_str());
     throw InputError(path, "cannot write checkpoint");

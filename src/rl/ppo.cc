@@ -1,5 +1,7 @@
 #include "rl/ppo.h"
 
+#include <algorithm>
+
 namespace m2d {
 
 RolloutStorage::RolloutStorage(int steps, int num_envs, int observation_size,
@@ -31,6 +33,18 @@ void ComputeGae(const torch::Tensor& rewards, const torch::Tensor& values,
     (*advantages)[t] = running;
   }
   *returns = *advantages + values;
+}
+
+double AdaptLearningRate(double learning_rate, double approx_kl,
+                         const PpoOptions& options) {
+  constexpr double kFactor = 1.5;
+  if (approx_kl > 2.0 * options.target_kl) {
+    learning_rate /= kFactor;
+  } else if (approx_kl < 0.5 * options.target_kl) {
+    learning_rate *= kFactor;
+  }
+  return std::clamp(learning_rate, options.learning_rate_min,
+                    options.learning_rate_max);
 }
 
 PpoLosses PpoUpdate(ActorCritic& model, torch::optim::Optimizer& optimizer,

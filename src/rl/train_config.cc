@@ -41,6 +41,11 @@ void PpoOptions::Validate() const {
   }
   if (!(learning_rate > 0))
     throw ConfigError("agent.learning_rate must be > 0");
+  if (!(target_kl >= 0)) throw ConfigError("agent.target_kl must be >= 0");
+  if (!(learning_rate_min > 0 && learning_rate_min <= learning_rate_max)) {
+    throw ConfigError(
+        "agent.learning_rate_min must be > 0 and <= learning_rate_max");
+  }
   if (!(max_grad_norm > 0))
     throw ConfigError("agent.max_grad_norm must be > 0");
   if (torch_threads < 1) throw ConfigError("agent.torch_threads must be >= 1");
@@ -146,6 +151,9 @@ TrainConfig ParseTrainConfig(const YAML::Node& node,
   agent.Optional("epochs", &p.epochs);
   agent.Optional("minibatch_size", &p.minibatch_size);
   agent.Optional("learning_rate", &p.learning_rate);
+  agent.Optional("target_kl", &p.target_kl);
+  agent.Optional("learning_rate_min", &p.learning_rate_min);
+  agent.Optional("learning_rate_max", &p.learning_rate_max);
   agent.Optional("max_grad_norm", &p.max_grad_norm);
   agent.Optional("value_loss_weight", &p.value_loss_weight);
   agent.Optional("entropy_weight", &p.entropy_weight);
@@ -252,6 +260,9 @@ std::string TrainConfigToYaml(const TrainConfig& config) {
   out << YAML::Key << "epochs" << YAML::Value << p.epochs;
   out << YAML::Key << "minibatch_size" << YAML::Value << p.minibatch_size;
   out << YAML::Key << "learning_rate" << YAML::Value << p.learning_rate;
+  out << YAML::Key << "target_kl" << YAML::Value << p.target_kl;
+  out << YAML::Key << "learning_rate_min" << YAML::Value << p.learning_rate_min;
+  out << YAML::Key << "learning_rate_max" << YAML::Value << p.learning_rate_max;
   out << YAML::Key << "max_grad_norm" << YAML::Value << p.max_grad_norm;
   out << YAML::Key << "value_loss_weight" << YAML::Value << p.value_loss_weight;
   out << YAML::Key << "entropy_weight" << YAML::Value << p.entropy_weight;

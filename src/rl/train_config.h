@@ -44,8 +44,14 @@ struct PpoOptions {
   double advantage_clip = 4.0;  // clip of normalized advantages (MimicKit)
   int epochs = 3;               // passes over each batch
   int minibatch_size = 512;     // samples per gradient step
-  double learning_rate = 2e-4;  // Adam
-  double max_grad_norm = 1.0;   // global gradient-norm clip
+  double learning_rate = 2e-4;  // Adam; with target_kl > 0, the start value
+  // > 0: after each iteration the learning rate follows rl_games' adaptive
+  // rule toward this KL between the rollout's and the updated policy (see
+  // AdaptLearningRate); 0: the rate stays fixed.
+  double target_kl = 0.0;
+  double learning_rate_min = 1e-6;  // bounds of the adaptive rate
+  double learning_rate_max = 1e-3;
+  double max_grad_norm = 1.0;  // global gradient-norm clip
   double value_loss_weight = 0.5;
   double entropy_weight = 0.0;         // only matters with a learned sigma
   double action_bound_weight = 10.0;   // penalty on means beyond [-1, 1]

@@ -42,9 +42,13 @@ void TrimLog(const std::string& path, int iteration) {
   std::string line;
   std::getline(in, line);  // header
   while (std::getline(in, line)) {
-    // Rows past the checkpoint, or torn by a kill mid-write, are dropped.
+    // Rows past the checkpoint, or torn by a kill mid-write, are dropped. A
+    // torn row's iteration is past the checkpoint too, unless the tear cut
+    // the number itself short ("1" of "12,..."): hence the comma.
     const int row_iteration = std::atoi(line.c_str());
-    if (row_iteration > 0 && row_iteration <= iteration) kept << line << "\n";
+    const bool whole_iteration = line.find(',') != std::string::npos;
+    if (whole_iteration && row_iteration > 0 && row_iteration <= iteration)
+      kept << line << "\n";
   }
   WriteFileAtomic(path, kept.str());
 }
@@ -75,6 +79,17 @@ struct Trainer::State {
   std::vector<CapturedState> captured;
   std::vector<float> captured_observations;
 
+  // Adam's rate, kept in its parameter groups (and so in checkpoints).
+  double LearningRate() const {
+    return static_cast<const torch::optim::AdamOptions&>(
+               optimizer->param_groups().front().options())
+        .lr();
+  }
+  void SetLearningRate(double learning_rate) {
+    for (torch::optim::OptimizerParamGroup& group : optimizer->param_groups())
+      static_cast<torch::optim::AdamOptions&>(group.options())
+          .lr(learning_rate);
+  }
   torch::Tensor Normalized(const torch::Tensor& raw) {
     return config.ppo.normalize_observations ? model->Normalize(raw) : raw;
   }
@@ -140,6 +155,17 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
       }
       torch::NoGradGuard no_grad;
       s.model->LogStd().fill_(std::log(config.model.action_std));
+    }
+    // A fixed rate is a setting; an adaptive one is training state and
+    // continues from where it was.
+    if (config.ppo.target_kl > 0) {
+      spdlog::info("adaptive learning rate continues at {}", s.LearningRate());
+    } else {
+      if (std::abs(s.LearningRate() - config.ppo.learning_rate) > 1e-15) {
+        spdlog::info("learning_rate {} -> {} (from the config)",
+                     s.LearningRate(), config.ppo.learning_rate);
+      }
+      s.SetLearningRate(config.ppo.learning_rate);
     }
     TrimLog(s.log_path, s.counters.iteration);
   } else {
@@ -309,10 +335,15 @@ TrainSummary Trainer::Run(
     std::vector<FinishedEpisode> finished;
     s.Collect(storage, &finished);
     double collect_s = SecondsSince(start);
-    // 2. Learn from it.
+    // 2. Learn from it (and, if adaptive, set the next update's rate).
     Clock::time_point update_start = Clock::now();
+    const double learning_rate = s.LearningRate();
     PpoLosses losses =
         PpoUpdate(s.model, *s.optimizer, storage, config.ppo, s.generator);
+    if (config.ppo.target_kl > 0) {
+      s.SetLearningRate(
+          AdaptLearningRate(learning_rate, losses.approx_kl, config.ppo));
+    }
     double update_s = SecondsSince(update_start);
     // 3. Refresh the initial-state buffers (ASI).
     Clock::time_point asi_start = Clock::now();
@@ -349,7 +380,9 @@ TrainSummary Trainer::Run(
     progress.policy_loss = losses.policy_loss;
     progress.value_loss = losses.value_loss;
     progress.entropy = losses.entropy;
-    progress.learning_rate = config.ppo.learning_rate;
+    progress.approx_kl = losses.approx_kl;
+    progress.clip_fraction = losses.clip_fraction;
+    progress.learning_rate = learning_rate;
     log << progress.iteration << ',' << progress.samples << ','
         << progress.wall_time_s << ',' << progress.samples_per_s << ','
         << progress.mean_return << ',' << progress.mean_episode_length << ','

@@ -24,6 +24,8 @@ struct TrainProgress {
   double succ = 0.0;    // fraction not ended by early exit
   double e2d_px = 0.0;  // mean 2D error of those episodes
   double policy_loss = 0.0, value_loss = 0.0, entropy = 0.0;
+  double approx_kl = 0.0;      // PPO update: mean KL(old || new) estimate
+  double clip_fraction = 0.0;  // and the share of clipped ratios
   double learning_rate = 0.0;
   double collect_s = 0.0, update_s = 0.0, asi_s = 0.0;  // time split
 };

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "common/error.h"
 #include "test_paths.h"
 
@@ -40,6 +42,27 @@ ObservationLayout SmallLayout() {
   layout.num_points = 3;
   layout.num_future_frames = 2;
   return layout;
+}
+
+TEST(AdaptLearningRate, FollowsTheTargetKlWithinItsBounds) {
+  PpoOptions options;
+  options.target_kl = 0.01;
+  options.learning_rate_min = 1e-6;
+  options.learning_rate_max = 1e-3;
+  // Far above 2x target: divided by 1.5; far below half: multiplied.
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(3e-4, 0.5, options), 2e-4);
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(2e-4, 0.001, options), 3e-4);
+  // Inside [target / 2, 2 target], the edges included: unchanged.
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(2e-4, 0.005, options), 2e-4);
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(2e-4, 0.02, options), 2e-4);
+  // Clamped to the bounds.
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(1.2e-6, 1.0, options), 1e-6);
+  EXPECT_DOUBLE_EQ(AdaptLearningRate(9e-4, 0.0, options), 1e-3);
+  // The KL seen after resuming at sigma 0.05 with a rate set for 0.1
+  // (0.5) takes 2e-4 into [target / 2, 2 target] territory in 5 steps.
+  double rate = 2e-4;
+  for (int i = 0; i < 5; ++i) rate = AdaptLearningRate(rate, 0.5, options);
+  EXPECT_NEAR(rate, 2e-4 / std::pow(1.5, 5), 1e-12);
 }
 
 TEST(Networks, AveragingIdenticalViewsEqualsOneView) {

@@ -20,7 +20,8 @@ std::string Write(const std::string& dir, const std::string& name,
 TEST(TrainConfig, ReadsSectionsInlineOrFromFilesAndRoundTrips) {
   std::string dir = testing::TempDir("train_config");
   Write(dir, "agent.yaml",
-        "num_envs: 8\nsteps_per_env: 16\nminibatch_size: 64\n");
+        "num_envs: 8\nsteps_per_env: 16\nminibatch_size: 64\n"
+        "target_kl: 0.02\n");
   std::string path =
       Write(dir, "config.yaml",
             "data: {bundles: [a.json]}\n"
@@ -30,6 +31,7 @@ TEST(TrainConfig, ReadsSectionsInlineOrFromFilesAndRoundTrips) {
   TrainConfig config = LoadTrainConfig(path);
   EXPECT_EQ(config.ppo.num_envs, 8);
   EXPECT_EQ(config.ppo.minibatch_size, 64);
+  EXPECT_DOUBLE_EQ(config.ppo.target_kl, 0.02);
   EXPECT_EQ(config.env.num_future_frames, 3);
   EXPECT_DOUBLE_EQ(config.env.reward.pose_alpha_per_px, 0.01);
   EXPECT_EQ(config.run.seed, 9u);
@@ -50,8 +52,9 @@ void ExpectConfigError(const std::string& text, const std::string& needle,
     FAIL() << "expected InputError for: " << text;
   } catch (const InputError& e) {
     std::string message = e.what();
-    if (names_config)
+    if (names_config) {
       EXPECT_NE(message.find(path), std::string::npos) << message;
+    }
     EXPECT_NE(message.find(needle), std::string::npos) << message;
   }
 }
@@ -70,6 +73,12 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
   ExpectConfigError(
       "data: {bundles: [a.json]}\nagent: {minibatch_size: 100000}\n",
       "minibatch_size");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {target_kl: -1}\n",
+                    "target_kl");
+  ExpectConfigError(
+      "data: {bundles: [a.json]}\n"
+      "agent: {learning_rate_min: 0.01, learning_rate_max: 0.001}\n",
+      "learning_rate_min");
 }
 
 }  // namespace

@@ -1,0 +1,136 @@
+#include "eval/evaluator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+#include "env/env_fixture.h"
+
+namespace m2d {
+namespace {
+
+constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
+
+// A scripted controller without LibTorch: every PD target at the centre of
+// its range, whatever it observes. It cannot walk.
+class ZeroPolicy : public Policy {
+ public:
+  ZeroPolicy(int observation_size, int action_size)
+      : observation_size_(observation_size), action_size_(action_size) {}
+  void Act(const float*, int batch, float* actions) override {
+    std::fill(actions, actions + batch * action_size_, 0.0f);
+  }
+  int observation_size() const override { return observation_size_; }
+  int action_size() const override { return action_size_; }
+
+ private:
+  int observation_size_, action_size_;
+};
+
+ZeroPolicy MakeZeroPolicy(const testing::WalkTask& task) {
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 0);
+  return ZeroPolicy(env.observation_size(), env.action_size());
+}
+
+TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  EvalOptions options;
+  options.episodes_per_view = 2;
+  options.episode_s = 3.0;  // 90 frames at 30 Hz
+  std::vector<EvalRow> rows =
+      EvaluatePolicy(policy, task.character, task.reference,
+                     task.initial_states, task.options, options);
+
+  const int episode_frames = 90;
+  ASSERT_EQ(rows.size(), task.reference->views().size());
+  for (const EvalRow& row : rows) {
+    SCOPED_TRACE(row.view);
+    EXPECT_EQ(row.bundle, "walk");
+    EXPECT_EQ(row.episodes, 2);
+    // The walk leaves the standing character behind: every rollout hits the
+    // 100 px early exit long before the episode's end.
+    EXPECT_EQ(row.succ, 0.0);
+    EXPECT_GE(row.mean_frames, 1.0);
+    EXPECT_LT(row.mean_frames, 0.5 * episode_frames);
+    EXPECT_TRUE(std::isfinite(row.e2d_px));
+    EXPECT_GT(row.e2d_px, 0.0);
+    EXPECT_LT(row.e2d_px, options.success_threshold_px);
+    // The bundle has 3D truth (from the motion) and no objects.
+    EXPECT_TRUE(std::isfinite(row.e3d_mm));
+    EXPECT_GT(row.e3d_mm, 0.0);
+    EXPECT_GE(row.e3d_root_mm, 0.0);
+    EXPECT_EQ(row.eo2d_px, -1.0);
+    EXPECT_TRUE(std::isfinite(row.jitter));
+  }
+  EvalRow all = AggregateRows(rows);
+  EXPECT_EQ(all.episodes, 2 * static_cast<int>(rows.size()));
+  EXPECT_EQ(all.succ, 0.0);
+}
+
+TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  EvalOptions options;
+  options.episodes_per_view = 3;
+  options.episode_s = 0.5;
+  options.success_threshold_px = 1e6;  // no frame can fail
+  std::vector<EvalRow> rows =
+      EvaluatePolicy(policy, task.character, task.reference,
+                     task.initial_states, task.options, options);
+  ASSERT_EQ(rows.size(), task.reference->views().size());
+  for (const EvalRow& row : rows) {
+    SCOPED_TRACE(row.view);
+    EXPECT_EQ(row.succ, 1.0);
+    EXPECT_EQ(row.mean_frames, 15.0);  // 0.5 s at 30 Hz, truncated
+    EXPECT_TRUE(std::isfinite(row.e2d_px));
+    EXPECT_GT(row.e2d_px, 0.0);
+  }
+  // The policy ignores what it observes, so every view rolls out the same
+  // motion from the same start frames: the 3D metrics, which never look
+  // through a camera, agree across views.
+  for (const EvalRow& row : rows) {
+    EXPECT_DOUBLE_EQ(row.e3d_mm, rows[0].e3d_mm);
+    EXPECT_DOUBLE_EQ(row.jitter, rows[0].jitter);
+  }
+  EXPECT_GT(rows[0].e3d_mm, 0.0);
+  EvalRow all = AggregateRows(rows);
+  EXPECT_EQ(all.succ, 1.0);
+  EXPECT_EQ(all.mean_frames, 15.0);
+}
+
+TEST(EvaluatePolicy, APolicyForAnotherEnvironmentIsRejected) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 1.0);
+  ZeroPolicy right = MakeZeroPolicy(task);
+  ZeroPolicy wrong(right.observation_size() + 1, right.action_size());
+  try {
+    EvaluatePolicy(wrong, task.character, task.reference, task.initial_states,
+                   task.options, EvalOptions());
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), "policy");
+    EXPECT_NE(
+        error.problem().find(std::to_string(right.observation_size() + 1)),
+        std::string::npos);
+  }
+}
+
+TEST(EvaluatePolicy, InvalidOptionsAreRejected) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 1.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  EvalOptions options;
+  options.episodes_per_view = 0;
+  EXPECT_THROW(EvaluatePolicy(policy, task.character, task.reference,
+                              task.initial_states, task.options, options),
+               ConfigError);
+}
+
+}  // namespace
+}  // namespace m2d

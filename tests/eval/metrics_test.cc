@@ -1,0 +1,224 @@
+#include "eval/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "eval/evaluator.h"
+
+namespace m2d {
+namespace {
+
+constexpr int kNumKeypoints = 17;  // COCO-17
+
+// A deterministic, non-degenerate COCO-17 pose per frame: keypoint j sits at
+// a distinct place that also moves with t.
+KeypointFrames MakePoses(int num_frames) {
+  KeypointFrames frames(num_frames);
+  for (int t = 0; t < num_frames; ++t) {
+    for (int j = 0; j < kNumKeypoints; ++j) {
+      frames[t].push_back(
+          {0.1 * j + 0.01 * t, 0.05 * (j % 5) - 0.02 * t, 1.7 - 0.1 * j});
+    }
+  }
+  return frames;
+}
+
+KeypointFrames Translated(KeypointFrames frames,
+                          const Eigen::Vector3d& offset_m) {
+  for (auto& frame : frames) {
+    for (Eigen::Vector3d& point : frame) point += offset_m;
+  }
+  return frames;
+}
+
+TEST(MeanPositionError, ConstantOffsetGivesItsLength) {
+  const KeypointFrames truth = MakePoses(5);
+  // A 3-4-5 triangle in centimetres: every keypoint is 5 cm off.
+  const KeypointFrames simulated = Translated(truth, {0.03, 0.04, 0.0});
+  EXPECT_NEAR(MeanPositionError(simulated, truth), 0.05, 1e-12);
+  EXPECT_EQ(MeanPositionError(truth, truth), 0.0);
+}
+
+TEST(MeanPositionError, AveragesOverKeypointsAndFrames) {
+  const KeypointFrames truth = MakePoses(2);
+  KeypointFrames simulated = truth;
+  // One keypoint of one frame off by 0.34 m: mean over 2 x 17 = 0.01 m.
+  simulated[1][3].z() += 0.34;
+  EXPECT_NEAR(MeanPositionError(simulated, truth), 0.01, 1e-12);
+}
+
+TEST(MeanPositionError, ComparesOnlyTheFramesBothHave) {
+  const KeypointFrames truth = MakePoses(6);
+  // Three simulated frames (an episode that ended early), 5 cm off.
+  KeypointFrames simulated = Translated(truth, {0.0, 0.0, 0.05});
+  simulated.resize(3);
+  EXPECT_NEAR(MeanPositionError(simulated, truth), 0.05, 1e-12);
+  EXPECT_EQ(MeanPositionError({}, truth), 0.0);
+}
+
+TEST(RootRelativePositionError, GlobalTranslationIsNotAnError) {
+  const KeypointLayout& layout = Coco17Layout();
+  const KeypointFrames truth = MakePoses(4);
+  const KeypointFrames drifted = Translated(truth, {1.5, -2.0, 0.3});
+  EXPECT_NEAR(RootRelativePositionError(drifted, truth, layout), 0.0, 1e-12);
+  // The global error sees the drift.
+  EXPECT_NEAR(MeanPositionError(drifted, truth),
+              std::sqrt(1.5 * 1.5 + 4 + 0.09), 1e-12);
+}
+
+TEST(RootRelativePositionError, MovedWristCountsOnceAveragedOverKeypoints) {
+  const KeypointLayout& layout = Coco17Layout();
+  const KeypointFrames truth = MakePoses(3);
+  // A drift plus a pose change: the left wrist (not a root keypoint) is
+  // 0.17 m off in every frame; the root (mid-hips) is unaffected, so the
+  // root-relative error is 0.17 / 17 keypoints.
+  KeypointFrames simulated = Translated(truth, {0.4, 0.0, -0.2});
+  const int wrist = static_cast<int>(Coco17::kLeftWrist);
+  for (auto& frame : simulated) frame[wrist].y() += 0.17;
+  EXPECT_NEAR(RootRelativePositionError(simulated, truth, layout), 0.01, 1e-12);
+}
+
+TEST(RootRelativePositionError, MovedHipShiftsTheRootForEveryKeypoint) {
+  const KeypointLayout& layout = Coco17Layout();
+  ASSERT_EQ(layout.root_keypoints,
+            (std::vector<int>{static_cast<int>(Coco17::kLeftHip),
+                              static_cast<int>(Coco17::kRightHip)}));
+  const KeypointFrames truth = MakePoses(2);
+  // Moving the left hip by d moves the root (mean of the hips) by d / 2:
+  // every keypoint, the left hip included, is then d / 2 off relative to it.
+  KeypointFrames simulated = truth;
+  const int left_hip = static_cast<int>(Coco17::kLeftHip);
+  for (auto& frame : simulated) frame[left_hip].x() += 0.2;
+  EXPECT_NEAR(RootRelativePositionError(simulated, truth, layout), 0.1, 1e-12);
+}
+
+// Positions of `num_keypoints` keypoints over `num_frames` frames at `fps`,
+// keypoint j following p_j(t) (in metres, t in seconds).
+template <typename Trajectory>
+KeypointFrames Sampled(int num_frames, int num_keypoints, double fps,
+                       Trajectory trajectory) {
+  KeypointFrames frames(num_frames);
+  for (int t = 0; t < num_frames; ++t) {
+    for (int j = 0; j < num_keypoints; ++j)
+      frames[t].push_back(trajectory(j, t / fps));
+  }
+  return frames;
+}
+
+TEST(MeanJerk, CubicMotionHasItsExactThirdDerivative) {
+  constexpr double kFps = 30.0;
+  // x(t) = a t^3 (+ lower-order terms, which do not change the jerk) has
+  // jerk 6a everywhere, and third finite differences of a cubic are exact.
+  // a = 500 m/s^3 -> 3000 m/s^3 = 3.0 in units of 10^3 m/s^3.
+  const double a = 500.0;
+  const Eigen::Vector3d direction = Eigen::Vector3d(1, 2, 2) / 3.0;  // unit
+  KeypointFrames positions =
+      Sampled(10, 3, kFps, [&](int j, double t) -> Eigen::Vector3d {
+        return direction * (a * t * t * t + 4.0 * t * t - 0.5 * t + j);
+      });
+  EXPECT_NEAR(MeanJerk(positions, kFps), 3.0, 1e-6);
+
+  // Per-keypoint jerks 6 * 100 and 6 * 300 m/s^3 average to 1.2 * 10^3.
+  KeypointFrames mixed =
+      Sampled(8, 2, kFps, [&](int j, double t) -> Eigen::Vector3d {
+        const double coefficient = j == 0 ? 100.0 : 300.0;
+        return {0.0, 0.0, coefficient * t * t * t};
+      });
+  EXPECT_NEAR(MeanJerk(mixed, kFps), 1.2, 1e-6);
+}
+
+TEST(MeanJerk, ScalesWithTheCubeOfTheFrameRate) {
+  // The same per-frame positions read at twice the rate: 8x the jerk.
+  KeypointFrames positions =
+      Sampled(6, 1, 30.0, [](int, double t) -> Eigen::Vector3d {
+        return {50.0 * t * t * t, 0.0, 0.0};
+      });
+  EXPECT_NEAR(MeanJerk(positions, 60.0), 8.0 * MeanJerk(positions, 30.0), 1e-9);
+}
+
+TEST(MeanJerk, LinearAndQuadraticMotionHaveNoJerk) {
+  constexpr double kFps = 30.0;
+  KeypointFrames linear =
+      Sampled(12, 17, kFps, [](int j, double t) -> Eigen::Vector3d {
+        return {1.3 * t + j, -0.7 * t, 0.2};
+      });
+  EXPECT_NEAR(MeanJerk(linear, kFps), 0.0, 1e-9);
+  KeypointFrames quadratic =
+      Sampled(12, 17, kFps, [](int j, double t) -> Eigen::Vector3d {
+        return {-4.9 * t * t + 2.0 * t, 0.1 * j, 3.0 * t * t};
+      });
+  EXPECT_NEAR(MeanJerk(quadratic, kFps), 0.0, 1e-9);
+}
+
+TEST(MeanJerk, FewerThanFourFramesGiveZero) {
+  // A third difference needs four frames; even a violent cubic reads 0.
+  for (int frames = 0; frames < 4; ++frames) {
+    KeypointFrames positions =
+        Sampled(frames, 2, 30.0, [](int, double t) -> Eigen::Vector3d {
+          return {1000.0 * t * t * t, 0.0, 0.0};
+        });
+    EXPECT_EQ(MeanJerk(positions, 30.0), 0.0) << frames << " frames";
+  }
+}
+
+EvalRow Row(const std::string& view, int episodes, double succ, double e2d_px,
+            double e3d_mm) {
+  EvalRow row;
+  row.bundle = "walk";
+  row.view = view;
+  row.episodes = episodes;
+  row.succ = succ;
+  row.e2d_px = e2d_px;
+  row.e3d_mm = e3d_mm;
+  row.e3d_root_mm = e3d_mm < 0 ? -1.0 : e3d_mm / 2;
+  row.jitter = 0.1 * episodes;
+  row.mean_frames = 10.0 * episodes;
+  return row;
+}
+
+TEST(AggregateRows, WeightsEachRowByItsEpisodes) {
+  std::vector<EvalRow> rows = {Row("front", 2, 1.0, 10.0, 100.0),
+                               Row("side", 6, 0.5, 30.0, 60.0)};
+  EvalRow all = AggregateRows(rows);
+  EXPECT_EQ(all.bundle, "all");
+  EXPECT_EQ(all.view, "all");
+  EXPECT_EQ(all.episodes, 8);
+  EXPECT_DOUBLE_EQ(all.succ, (2 * 1.0 + 6 * 0.5) / 8);       // 0.625
+  EXPECT_DOUBLE_EQ(all.e2d_px, (2 * 10.0 + 6 * 30.0) / 8);   // 25
+  EXPECT_DOUBLE_EQ(all.e3d_mm, (2 * 100.0 + 6 * 60.0) / 8);  // 70
+  EXPECT_DOUBLE_EQ(all.e3d_root_mm, 35.0);
+  EXPECT_DOUBLE_EQ(all.jitter, (2 * 0.2 + 6 * 0.6) / 8);         // 0.5
+  EXPECT_DOUBLE_EQ(all.mean_frames, (2 * 20.0 + 6 * 60.0) / 8);  // 50
+  // Neither row has objects: EO2D stays "not measured".
+  EXPECT_EQ(all.eo2d_px, -1.0);
+}
+
+TEST(AggregateRows, AMetricMissingFromAnyRowIsMissingFromTheAggregate) {
+  // The second bundle has no 3D truth (-1): averaging the first row's E3D
+  // alone would misreport it as the whole set's, so the aggregate has none.
+  std::vector<EvalRow> rows = {Row("front", 4, 1.0, 12.0, 80.0),
+                               Row("side", 4, 0.0, 40.0, -1.0)};
+  rows[0].eo2d_px = 7.0;
+  EvalRow all = AggregateRows(rows);
+  EXPECT_EQ(all.e3d_mm, -1.0);
+  EXPECT_EQ(all.e3d_root_mm, -1.0);
+  EXPECT_EQ(all.eo2d_px, -1.0);
+  // The metrics every row has are still averaged.
+  EXPECT_EQ(all.episodes, 8);
+  EXPECT_DOUBLE_EQ(all.succ, 0.5);
+  EXPECT_DOUBLE_EQ(all.e2d_px, 26.0);
+}
+
+TEST(AggregateRows, NoEpisodesGiveAnEmptyAllRow) {
+  EvalRow all = AggregateRows({});
+  EXPECT_EQ(all.bundle, "all");
+  EXPECT_EQ(all.episodes, 0);
+  EXPECT_EQ(all.succ, 0.0);
+  EXPECT_EQ(all.e3d_mm, -1.0);
+}
+
+}  // namespace
+}  // namespace m2d

@@ -1,0 +1,325 @@
+#include "rl/checkpoint.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "common/error.h"
+#include "env/env_fixture.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+namespace fs = std::filesystem;
+
+ObservationLayout SmallLayout() {
+  ObservationLayout layout;
+  layout.num_bodies = 2;
+  layout.num_points = 3;
+  layout.num_future_frames = 2;
+  return layout;
+}
+
+ModelOptions TinyModel() {
+  ModelOptions options;
+  options.encoder_hidden = {16};
+  options.encoder_features = 8;
+  options.policy_hidden = {32};
+  options.critic_hidden = {32};
+  return options;
+}
+
+constexpr int kActions = 4;
+
+// A model whose weights, normalizer buffers and Adam moments have all moved
+// from their initial values, as in a real run.
+struct TrainedModel {
+  ActorCritic model{nullptr};
+  std::unique_ptr<torch::optim::Adam> optimizer;
+};
+
+torch::Tensor Loss(ActorCritic& model, const torch::Tensor& raw) {
+  torch::Tensor obs = model->Normalize(raw);
+  return model->ActionMean(obs).pow(2).mean() +
+         (model->Value(obs) - 1.0).pow(2).mean();
+}
+
+TrainedModel MakeTrainedModel(const ObservationLayout& layout, int actions,
+                              uint64_t seed) {
+  torch::manual_seed(seed);
+  TrainedModel trained;
+  trained.model = ActorCritic(layout, TinyModel(), actions);
+  trained.optimizer = std::make_unique<torch::optim::Adam>(
+      trained.model->parameters(), torch::optim::AdamOptions(1e-3));
+  for (int step = 0; step < 3; ++step) {
+    torch::Tensor raw = torch::randn({16, layout.size()}) * 2.0 + 0.5;
+    trained.model->UpdateNormalizer(raw);
+    trained.optimizer->zero_grad();
+    Loss(trained.model, raw).backward();
+    trained.optimizer->step();
+  }
+  return trained;
+}
+
+// A model and optimizer as a resuming trainer builds them: same config,
+// different random initialization, no optimizer state.
+TrainedModel MakeFreshModel(const ObservationLayout& layout, int actions,
+                            uint64_t seed) {
+  torch::manual_seed(seed);
+  TrainedModel fresh;
+  fresh.model = ActorCritic(layout, TinyModel(), actions);
+  fresh.optimizer = std::make_unique<torch::optim::Adam>(
+      fresh.model->parameters(), torch::optim::AdamOptions(1e-3));
+  return fresh;
+}
+
+bool SameTensors(const torch::OrderedDict<std::string, torch::Tensor>& a,
+                 const torch::OrderedDict<std::string, torch::Tensor>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].key() != b[i].key() || !torch::equal(a[i].value(), b[i].value()))
+      return false;
+  }
+  return true;
+}
+
+// LibTorch keys optimizer state by the parameter's TensorImpl address.
+const torch::optim::AdamParamState* AdamState(
+    const torch::optim::Adam& optimizer, const torch::Tensor& parameter) {
+  auto it = optimizer.state().find(
+      c10::guts::to_string(parameter.unsafeGetTensorImpl()));
+  if (it == optimizer.state().end()) return nullptr;
+  return static_cast<const torch::optim::AdamParamState*>(it->second.get());
+}
+
+TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
+  const std::string dir = testing::TempDir("checkpoint_round_trip");
+  const std::string path = dir + "/checkpoint.pt";
+  const ObservationLayout layout = SmallLayout();
+  TrainedModel saved = MakeTrainedModel(layout, kActions, 1);
+  TrainConfig config;
+  config.data.bundles = {"walk.json"};  // read back, so it must validate
+  config.ppo.num_envs = 24;  // 24 x 32 steps: room for the 512 minibatch
+  config.model = TinyModel();
+  CheckpointCounters counters;
+  counters.iteration = 37;
+  counters.samples = 123'456'789'012;  // past 2^32
+  counters.wall_time_s = 2775.83;      // not an integer
+  SaveCheckpoint(path, config, saved.model, *saved.optimizer, counters, nullptr,
+                 SimState());
+
+  TrainedModel loaded = MakeFreshModel(layout, kActions, 2);
+  ASSERT_FALSE(SameTensors(saved.model->named_parameters(),
+                           loaded.model->named_parameters()));
+  ASSERT_FALSE(
+      SameTensors(saved.model->named_buffers(), loaded.model->named_buffers()));
+  CheckpointCounters read = LoadCheckpoint(
+      path, loaded.model, loaded.optimizer.get(), nullptr, SimState());
+  EXPECT_EQ(read.iteration, 37);
+  EXPECT_EQ(read.samples, 123'456'789'012);
+  EXPECT_EQ(read.wall_time_s, 2775.83);  // exactly: stored as a double
+
+  // Weights and the observation normalizer's running statistics.
+  EXPECT_TRUE(SameTensors(saved.model->named_parameters(),
+                          loaded.model->named_parameters()));
+  EXPECT_TRUE(
+      SameTensors(saved.model->named_buffers(), loaded.model->named_buffers()));
+
+  // Adam's per-parameter step count and moments. The fixed log_std takes no
+  // gradient, so Adam keeps no state for it.
+  const std::vector<torch::Tensor> saved_parameters = saved.model->parameters();
+  const std::vector<torch::Tensor> loaded_parameters =
+      loaded.model->parameters();
+  ASSERT_EQ(saved_parameters.size(), loaded_parameters.size());
+  int with_state = 0;
+  for (size_t i = 0; i < saved_parameters.size(); ++i) {
+    SCOPED_TRACE(i);
+    const auto* before = AdamState(*saved.optimizer, saved_parameters[i]);
+    const auto* after = AdamState(*loaded.optimizer, loaded_parameters[i]);
+    ASSERT_EQ(before == nullptr, after == nullptr);
+    if (before == nullptr) continue;
+    ++with_state;
+    EXPECT_EQ(before->step(), 3);
+    EXPECT_EQ(after->step(), 3);
+    EXPECT_TRUE(torch::equal(before->exp_avg(), after->exp_avg()));
+    EXPECT_TRUE(torch::equal(before->exp_avg_sq(), after->exp_avg_sq()));
+  }
+  EXPECT_EQ(with_state, static_cast<int>(saved_parameters.size()) - 1);
+
+  // So the next update is the one the saved run would have made.
+  torch::manual_seed(3);
+  torch::Tensor raw = torch::randn({16, layout.size()});
+  for (TrainedModel* model : {&saved, &loaded}) {
+    model->optimizer->zero_grad();
+    Loss(model->model, raw).backward();
+    model->optimizer->step();
+  }
+  EXPECT_TRUE(SameTensors(saved.model->named_parameters(),
+                          loaded.model->named_parameters()));
+
+  // The embedded config and layout rebuild the networks.
+  EXPECT_EQ(ReadCheckpointConfig(path).ppo.num_envs, 24);
+  int action_size = 0;
+  ObservationLayout read_layout = ReadCheckpointLayout(path, &action_size);
+  EXPECT_EQ(action_size, kActions);
+  EXPECT_EQ(read_layout.size(), layout.size());
+  EXPECT_EQ(read_layout.num_bodies, layout.num_bodies);
+  EXPECT_EQ(read_layout.num_future_frames, layout.num_future_frames);
+  fs::remove_all(dir);
+}
+
+// Expects `load` to throw an InputError naming `path`.
+template <typename Load>
+void ExpectInputErrorNaming(const std::string& path, Load load) {
+  try {
+    load();
+    ADD_FAILURE() << "expected InputError for " << path;
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), path);
+  }
+}
+
+TEST(Checkpoint, TruncatedOrForeignFilesAreInputErrorsNamingTheFile) {
+  const std::string dir = testing::TempDir("checkpoint_corrupt");
+  const std::string path = dir + "/checkpoint.pt";
+  TrainedModel saved = MakeTrainedModel(SmallLayout(), kActions, 1);
+  SaveCheckpoint(path, TrainConfig(), saved.model, *saved.optimizer,
+                 CheckpointCounters(), nullptr, SimState());
+  TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 2);
+
+  // A copy cut in half, as a kill during a non-atomic copy would leave it.
+  const std::string truncated = dir + "/truncated.pt";
+  fs::copy_file(path, truncated);
+  fs::resize_file(truncated, fs::file_size(path) / 2);
+  ExpectInputErrorNaming(truncated, [&] {
+    LoadCheckpoint(truncated, loaded.model, loaded.optimizer.get(), nullptr,
+                   SimState());
+  });
+  ExpectInputErrorNaming(truncated, [&] { ReadCheckpointConfig(truncated); });
+
+  const std::string text = dir + "/notes.pt";
+  std::ofstream(text) << "not a checkpoint\n";
+  ExpectInputErrorNaming(text, [&] {
+    LoadCheckpoint(text, loaded.model, nullptr, nullptr, SimState());
+  });
+
+  const std::string missing = dir + "/missing.pt";
+  ExpectInputErrorNaming(missing, [&] {
+    LoadCheckpoint(missing, loaded.model, nullptr, nullptr, SimState());
+  });
+  fs::remove_all(dir);
+}
+
+TEST(Checkpoint, AFailedSaveLeavesThePreviousCheckpoint) {
+  const std::string dir = testing::TempDir("checkpoint_atomic");
+  const std::string path = dir + "/checkpoint.pt";
+  TrainedModel first = MakeTrainedModel(SmallLayout(), kActions, 1);
+  CheckpointCounters counters;
+  counters.iteration = 5;
+  counters.wall_time_s = 12.5;
+  SaveCheckpoint(path, TrainConfig(), first.model, *first.optimizer, counters,
+                 nullptr, SimState());
+  // Only the checkpoint remains: the temporary file was renamed over it.
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+
+  // The save writes a temporary file next to the checkpoint first; a
+  // directory in its place makes that write fail (as a full disk would).
+  // (Running as root, a read-only folder would not stop the write.)
+  const std::string blocked = path + ".tmp." + std::to_string(::getpid());
+  fs::create_directory(blocked);
+  TrainedModel second = MakeTrainedModel(SmallLayout(), kActions, 9);
+  counters.iteration = 6;
+  try {
+    SaveCheckpoint(path, TrainConfig(), second.model, *second.optimizer,
+                   counters, nullptr, SimState());
+    ADD_FAILURE() << "the save into a blocked temporary path succeeded";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.source(), path);
+    EXPECT_NE(std::string(e.what()).find("cannot write checkpoint"),
+              std::string::npos)
+        << e.what();
+  }
+  TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 2);
+  CheckpointCounters read =
+      LoadCheckpoint(path, loaded.model, nullptr, nullptr, SimState());
+  EXPECT_EQ(read.iteration, 5);
+  EXPECT_EQ(read.wall_time_s, 12.5);
+  EXPECT_TRUE(SameTensors(first.model->named_parameters(),
+                          loaded.model->named_parameters()));
+
+  // Saving into a folder that does not exist fails and creates nothing.
+  const std::string nowhere = dir + "/no_such_dir/checkpoint.pt";
+  EXPECT_THROW(SaveCheckpoint(nowhere, TrainConfig(), second.model,
+                              *second.optimizer, counters, nullptr, SimState()),
+               InputError);
+  EXPECT_FALSE(fs::exists(dir + "/no_such_dir"));
+  fs::remove_all(dir);
+}
+
+TEST(Checkpoint, InitialStateBuffersRoundTrip) {
+  M2D_REQUIRE_SHARED(walk_path, "deepmimic/motions/humanoid3d_walk.txt");
+  const std::string dir = testing::TempDir("checkpoint_asi");
+  const std::string path = dir + "/checkpoint.pt";
+  testing::WalkTask task = testing::MakeWalkTask(walk_path, 1.0);
+  const SimState state_template =
+      Simulation(task.character, task.options.simulation).Save();
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 0);
+  TrainedModel saved = MakeTrainedModel(env.layout(), env.action_size(), 1);
+
+  // ASI as training leaves it: visited states with critic scores added to
+  // some frames (distinct states, so a mix-up would show).
+  StateBuffer& buffer = task.initial_states->buffer(0);
+  const int capacity = buffer.options().capacity_per_frame;
+  for (int frame : {0, 7, buffer.num_frames() - 1}) {
+    for (int k = 0; k < capacity; ++k) {
+      SimState state = buffer.entry(frame, 0).state;
+      state.qpos[0] += 0.01 * (k + 1);
+      state.qvel[2] -= 0.3 * k;
+      state.time_s += 0.001 * k;
+      buffer.Insert(frame, state, 1.5 + 0.25 * k + frame);
+    }
+  }
+  SaveCheckpoint(path, TrainConfig(), saved.model, *saved.optimizer,
+                 CheckpointCounters(), task.initial_states.get(),
+                 state_template);
+
+  InitialStates restored(*task.reference, task.character,
+                         task.options.simulation, StateBufferOptions());
+  ASSERT_NE(restored.buffer(0).size(7), buffer.size(7));
+  TrainedModel loaded = MakeFreshModel(env.layout(), env.action_size(), 2);
+  LoadCheckpoint(path, loaded.model, loaded.optimizer.get(), &restored,
+                 state_template);
+
+  const StateBuffer& read = restored.buffer(0);
+  ASSERT_EQ(read.num_frames(), buffer.num_frames());
+  for (int f = 0; f < buffer.num_frames(); ++f) {
+    ASSERT_EQ(read.size(f), buffer.size(f)) << "frame " << f;
+    for (int i = 0; i < buffer.size(f); ++i) {
+      SCOPED_TRACE("frame " + std::to_string(f) + " entry " +
+                   std::to_string(i));
+      const ScoredState& a = buffer.entry(f, i);
+      const ScoredState& b = read.entry(f, i);
+      EXPECT_EQ(b.score, a.score);
+      EXPECT_EQ(b.state.time_s, a.state.time_s);
+      EXPECT_EQ(b.state.qpos, a.state.qpos);
+      EXPECT_EQ(b.state.qvel, a.state.qvel);
+      EXPECT_EQ(b.state.act, a.state.act);
+      EXPECT_EQ(b.state.qacc_warmstart, a.state.qacc_warmstart);
+      EXPECT_EQ(b.state.ctrl, a.state.ctrl);
+      EXPECT_EQ(b.state.qfrc_applied, a.state.qfrc_applied);
+      EXPECT_EQ(b.state.xfrc_applied, a.state.xfrc_applied);
+      EXPECT_EQ(b.state.mocap_pos, a.state.mocap_pos);
+      EXPECT_EQ(b.state.mocap_quat, a.state.mocap_quat);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace m2d

@@ -1,0 +1,232 @@
+// Resuming a training run: counters, the log and settings carry over from
+// the checkpoint. Tiny networks and batches: only the bookkeeping matters.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "motion/bundle.h"
+#include "motion/motion_io.h"
+#include "rl/checkpoint.h"
+#include "rl/trainer.h"
+#include "sim/simulation.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
+
+// A 1 s walk bundle written into `dir`, and a config training on it with
+// 4 envs x 16 steps (64 samples per iteration) and tiny networks.
+TrainConfig TinyConfig(const std::string& walk_path, const std::string& dir) {
+  TrainConfig config;
+  config.data.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  auto character = LoadCharacterForSimulation(config.data.character_config,
+                                              "flat", config.env.simulation);
+  BundleFromMotionOptions bundle_options;
+  bundle_options.duration_s = 1.0;
+  bundle_options.follow = CameraFollow::kRootDolly;
+  config.data.bundles = {dir + "/walk1s.json"};
+  WriteBundle(config.data.bundles[0],
+              MakeBundleFromMotion(
+                  ReadDeepMimicMotion(walk_path, character->shared_skeleton()),
+                  character->keypoint_map(), bundle_options, "walk1s"));
+  config.model.encoder_hidden = {16};
+  config.model.encoder_features = 8;
+  config.model.policy_hidden = {32};
+  config.model.critic_hidden = {32};
+  config.ppo.num_envs = 4;
+  config.ppo.steps_per_env = 16;
+  config.ppo.minibatch_size = 32;
+  config.ppo.epochs = 1;
+  config.run.run_dir = dir + "/run";
+  config.run.seed = 3;
+  config.run.env_threads = 1;
+  config.run.checkpoint_minutes = 60.0;  // only the final checkpoint
+  config.Validate();
+  return config;
+}
+
+constexpr int64_t kBatch = 4 * 16;
+
+struct RunResult {
+  TrainSummary summary;
+  std::vector<TrainProgress> progress;
+  double elapsed_s = 0.0;  // of the Run() call, measured outside it
+};
+
+RunResult TrainIterations(const TrainConfig& config, bool resume,
+                          int iterations) {
+  Trainer trainer(config, resume);
+  RunResult result;
+  auto start = std::chrono::steady_clock::now();
+  result.summary =
+      trainer.Run(iterations, nullptr, [&](const TrainProgress& progress) {
+        result.progress.push_back(progress);
+      });
+  result.elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return result;
+}
+
+struct LogRow {
+  int iteration = 0;
+  int64_t samples = 0;
+  double wall_time_s = 0.0;
+};
+
+std::vector<LogRow> ReadLog(const std::string& run_dir) {
+  std::ifstream in(run_dir + "/train_log.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("iteration,samples,wall_time_s,", 0), 0u) << line;
+  std::vector<LogRow> rows;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    LogRow row;
+    char comma;
+    fields >> row.iteration >> comma >> row.samples >> comma >> row.wall_time_s;
+    EXPECT_TRUE(fields) << "malformed row: " << line;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+void AppendToLog(const std::string& run_dir, const std::string& text) {
+  std::ofstream(run_dir + "/train_log.csv", std::ios::app) << text;
+}
+
+CheckpointCounters ReadCounters(const std::string& path,
+                                torch::Tensor* log_std = nullptr) {
+  TrainConfig config = ReadCheckpointConfig(path);
+  int action_size = 0;
+  ObservationLayout layout = ReadCheckpointLayout(path, &action_size);
+  ActorCritic model(layout, config.model, action_size);
+  CheckpointCounters counters =
+      LoadCheckpoint(path, model, nullptr, nullptr, SimState());
+  if (log_std != nullptr) *log_std = model->LogStd().detach().clone();
+  return counters;
+}
+
+TEST(Resume, ContinuesCountersAndLogWhereTheCheckpointLeftOff) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_continues");
+  const TrainConfig config = TinyConfig(walk_path, dir);
+
+  RunResult first = TrainIterations(config, /*resume=*/false, 3);
+  ASSERT_EQ(first.summary.iterations_run, 3);
+  ASSERT_EQ(first.summary.last.iteration, 3);
+  EXPECT_EQ(first.summary.last.samples, 3 * kBatch);
+  const double first_wall_s = first.summary.last.wall_time_s;
+  CheckpointCounters saved = ReadCounters(first.summary.checkpoint_path);
+  EXPECT_EQ(saved.iteration, 3);
+  EXPECT_EQ(saved.samples, 3 * kBatch);
+  EXPECT_EQ(saved.wall_time_s, first_wall_s);
+
+  RunResult second = TrainIterations(config, /*resume=*/true, 2);
+  EXPECT_EQ(second.summary.iterations_run, 2);
+  ASSERT_EQ(second.progress.size(), 2u);
+  EXPECT_EQ(second.progress[0].iteration, 4);
+  EXPECT_EQ(second.progress[1].iteration, 5);
+  EXPECT_EQ(second.progress[0].samples, 4 * kBatch);
+  EXPECT_EQ(second.progress[1].samples, 5 * kBatch);
+  // Wall time adds this run's iterations to the first run's total: more
+  // than it, by no more than the second Run() took.
+  EXPECT_GT(second.progress[0].wall_time_s, first_wall_s);
+  EXPECT_GT(second.progress[1].wall_time_s, second.progress[0].wall_time_s);
+  EXPECT_LE(second.progress[1].wall_time_s,
+            first_wall_s + second.elapsed_s + 1e-6);
+  CheckpointCounters final_counters =
+      ReadCounters(second.summary.checkpoint_path);
+  EXPECT_EQ(final_counters.iteration, 5);
+  EXPECT_EQ(final_counters.samples, 5 * kBatch);
+  EXPECT_EQ(final_counters.wall_time_s, second.summary.last.wall_time_s);
+
+  std::vector<LogRow> log = ReadLog(config.run.run_dir);
+  ASSERT_EQ(log.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(log[i].iteration, i + 1);
+    EXPECT_EQ(log[i].samples, (i + 1) * kBatch);
+    if (i > 0) {
+      EXPECT_GT(log[i].wall_time_s, log[i - 1].wall_time_s);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Resume, WithoutACheckpointStartsFresh) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_fresh");
+  const TrainConfig config = TinyConfig(walk_path, dir);
+  ASSERT_FALSE(fs::exists(config.run.run_dir + "/checkpoint.pt"));
+
+  RunResult run = TrainIterations(config, /*resume=*/true, 1);
+  ASSERT_EQ(run.progress.size(), 1u);
+  EXPECT_EQ(run.progress[0].iteration, 1);
+  EXPECT_EQ(run.progress[0].samples, kBatch);
+  EXPECT_LE(run.progress[0].wall_time_s, run.elapsed_s);
+  std::vector<LogRow> log = ReadLog(config.run.run_dir);
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_EQ(log[0].iteration, 1);
+  EXPECT_TRUE(fs::exists(config.run.run_dir + "/checkpoint.pt"));
+  fs::remove_all(dir);
+}
+
+TEST(Resume, DropsLogRowsPastTheCheckpoint) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_trim");
+  const TrainConfig config = TinyConfig(walk_path, dir);
+  TrainIterations(config, /*resume=*/false, 2);
+  // A run killed after logging past its last checkpoint: a whole row that
+  // the checkpoint does not know about, then row 10 torn mid-write after
+  // its first digit (which alone reads as iteration 1).
+  AppendToLog(config.run.run_dir,
+              "9,999999,1.5,1,2,3,0.5,10,0.1,0.2,0.3,0.0002\n1");
+
+  RunResult resumed = TrainIterations(config, /*resume=*/true, 1);
+  ASSERT_EQ(resumed.progress.size(), 1u);
+  EXPECT_EQ(resumed.progress[0].iteration, 3);
+  std::vector<LogRow> log = ReadLog(config.run.run_dir);
+  ASSERT_EQ(log.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(log[i].iteration, i + 1);
+    EXPECT_EQ(log[i].samples, (i + 1) * kBatch);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Resume, AFixedActionStdFollowsTheConfig) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_action_std");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  ASSERT_FALSE(config.model.learn_action_std);
+  config.model.action_std = 0.2;
+  RunResult first = TrainIterations(config, /*resume=*/false, 1);
+  torch::Tensor log_std;
+  ReadCounters(first.summary.checkpoint_path, &log_std);
+  EXPECT_TRUE(torch::allclose(log_std, torch::full_like(log_std, std::log(0.2)),
+                              0.0, 1e-6));
+
+  // Less exploration for the rest of the run.
+  config.model.action_std = 0.05;
+  RunResult second = TrainIterations(config, /*resume=*/true, 1);
+  EXPECT_EQ(second.summary.last.iteration, 2);
+  ReadCounters(second.summary.checkpoint_path, &log_std);
+  EXPECT_TRUE(torch::allclose(
+      log_std, torch::full_like(log_std, std::log(0.05)), 0.0, 1e-6))
+      << log_std;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace m2d
