@@ -2,9 +2,11 @@
 #ifndef MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_
 #define MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
+#include "env/policy.h"
 #include "env/reference.h"
 #include "env/tracking_env.h"
 #include "motion/bundle.h"
@@ -39,6 +41,24 @@ inline ReferenceBundle MakeWalkBundle(const std::string& motion_path,
   return MakeBundleFromMotion(motion, character.keypoint_map(), options,
                               "walk");
 }
+
+// A scripted controller without LibTorch: every PD target at the centre of
+// its range, whatever it observes. It cannot walk.
+class ZeroPolicy : public Policy {
+ public:
+  ZeroPolicy(int observation_size, int action_size)
+      : observation_size_(observation_size), action_size_(action_size) {}
+  void Act(const float*, int batch, float* actions) override {
+    std::fill(actions, actions + batch * action_size_, 0.0f);
+    ++calls;
+  }
+  int observation_size() const override { return observation_size_; }
+  int action_size() const override { return action_size_; }
+  int calls = 0;  // Act() calls so far
+
+ private:
+  int observation_size_, action_size_;
+};
 
 inline WalkTask MakeWalkTask(const std::string& motion_path,
                              double duration_s = 4.0) {

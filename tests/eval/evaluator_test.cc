@@ -11,23 +11,9 @@
 namespace m2d {
 namespace {
 
+using testing::ZeroPolicy;
+
 constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
-
-// A scripted controller without LibTorch: every PD target at the centre of
-// its range, whatever it observes. It cannot walk.
-class ZeroPolicy : public Policy {
- public:
-  ZeroPolicy(int observation_size, int action_size)
-      : observation_size_(observation_size), action_size_(action_size) {}
-  void Act(const float*, int batch, float* actions) override {
-    std::fill(actions, actions + batch * action_size_, 0.0f);
-  }
-  int observation_size() const override { return observation_size_; }
-  int action_size() const override { return action_size_; }
-
- private:
-  int observation_size_, action_size_;
-};
 
 ZeroPolicy MakeZeroPolicy(const testing::WalkTask& task) {
   TrackingEnv env(task.character, task.reference, task.initial_states,

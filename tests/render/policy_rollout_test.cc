@@ -7,22 +7,7 @@
 namespace m2d {
 namespace {
 
-// A scripted controller: holds every PD target at the range centre.
-class ZeroPolicy : public Policy {
- public:
-  ZeroPolicy(int observation_size, int action_size)
-      : observation_size_(observation_size), action_size_(action_size) {}
-  void Act(const float*, int batch, float* actions) override {
-    std::fill(actions, actions + batch * action_size_, 0.0f);
-    ++calls;
-  }
-  int observation_size() const override { return observation_size_; }
-  int action_size() const override { return action_size_; }
-  int calls = 0;
-
- private:
-  int observation_size_, action_size_;
-};
+using testing::ZeroPolicy;
 
 TEST(PolicyRollout, RecordsOneFramePerStateWithItsCameraAndReference) {
   M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");

@@ -5,6 +5,7 @@
 
 #include <chrono>
 
+#include "env/env_fixture.h"
 #include "eval/evaluator.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
@@ -32,12 +33,7 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
       testing::SourcePath("assets/characters/humanoid.yaml");
   auto character = LoadCharacterForSimulation(config.data.character_config,
                                               "flat", config.env.simulation);
-  BundleFromMotionOptions bundle_options;
-  bundle_options.duration_s = 2.0;
-  bundle_options.follow = CameraFollow::kRootDolly;
-  ReferenceBundle bundle = MakeBundleFromMotion(
-      ReadDeepMimicMotion(walk_path, character->shared_skeleton()),
-      character->keypoint_map(), bundle_options, "walk2s");
+  ReferenceBundle bundle = testing::MakeWalkBundle(walk_path, *character, 2.0);
   config.data.bundles = {dir + "/walk2s.json"};
   WriteBundle(config.data.bundles[0], bundle);
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "env/env_fixture.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
 #include "rl/checkpoint.h"
@@ -32,14 +33,9 @@ TrainConfig TinyConfig(const std::string& walk_path, const std::string& dir) {
       testing::SourcePath("assets/characters/humanoid.yaml");
   auto character = LoadCharacterForSimulation(config.data.character_config,
                                               "flat", config.env.simulation);
-  BundleFromMotionOptions bundle_options;
-  bundle_options.duration_s = 1.0;
-  bundle_options.follow = CameraFollow::kRootDolly;
   config.data.bundles = {dir + "/walk1s.json"};
   WriteBundle(config.data.bundles[0],
-              MakeBundleFromMotion(
-                  ReadDeepMimicMotion(walk_path, character->shared_skeleton()),
-                  character->keypoint_map(), bundle_options, "walk1s"));
+              testing::MakeWalkBundle(walk_path, *character, 1.0));
   config.model.encoder_hidden = {16};
   config.model.encoder_features = 8;
   config.model.policy_hidden = {32};
