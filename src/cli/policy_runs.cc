@@ -74,6 +74,7 @@ std::vector<EvalRow> EvaluateCheckpoint(
   for (const std::string& path : paths) bundles.push_back(ReadBundle(path));
   auto reference = TrackingReference::Prepare(std::move(bundles), *character,
                                               config.env.simulation.control_hz);
+  // Noise-free initial states (sigma 0), whatever the run trained with.
   auto states = std::make_shared<InitialStates>(
       *reference, character, config.env.simulation, StateBufferOptions());
   return EvaluatePolicy(policy, character, reference, states, config.env,
@@ -109,6 +110,7 @@ EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
   auto character = LoadTrainedCharacter(config);
   auto reference = TrackingReference::Prepare({bundle}, *character,
                                               config.env.simulation.control_hz);
+  // Noise-free initial states (sigma 0), whatever the run trained with.
   auto states = std::make_shared<InitialStates>(
       *reference, character, config.env.simulation, StateBufferOptions());
   int view_index = 0;
@@ -121,7 +123,6 @@ EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
   }
   TrackingEnvOptions env_options = config.env;
   env_options.max_episode_s = episode_s;
-  env_options.initial_state_noise_rad = 0.0;
   TrackingEnv env(character, reference, states, env_options, 0);
   RecordedFrames frames(RecordPolicyRollout(policy, env, *reference, *states,
                                             view_index, start_frame));

@@ -4,6 +4,7 @@
 #ifndef MIMIC2D_ENV_REFERENCE_H_
 #define MIMIC2D_ENV_REFERENCE_H_
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,10 +65,15 @@ class InitialStates {
   // Fills each frame from the bundle's 3D ground-truth poses when present
   // (velocities by finite differences), otherwise from the model's default
   // pose placed so that it projects onto the 2D root at the 2D scale.
+  // With `joint_noise_rad` > 0 ("Noisy S.I."), every actuated hinge angle of
+  // every state gets Gaussian noise of that sigma once, here (kept within
+  // the hinge's range), and the character is moved vertically so that its
+  // lowest point is where it was without noise, not in the floor.
   InitialStates(const TrackingReference& reference,
                 std::shared_ptr<const Character> character,
                 const SimulationOptions& simulation_options,
-                const StateBufferOptions& options);
+                const StateBufferOptions& options, double joint_noise_rad = 0.0,
+                uint64_t noise_seed = 0);
 
   StateBuffer& buffer(int bundle) { return buffers_[bundle]; }
   const StateBuffer& buffer(int bundle) const { return buffers_[bundle]; }

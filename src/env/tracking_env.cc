@@ -66,15 +66,6 @@ void TrackingEnv::Reset(float* observation) {
 void TrackingEnv::ResetTo(int view_index, int frame, const SimState& state,
                           float* observation) {
   simulation_.Restore(state);
-  if (options_.initial_state_noise_rad > 0) {
-    std::normal_distribution<double> noise(0.0,
-                                           options_.initial_state_noise_rad);
-    mjData* data = simulation_.mutable_data();
-    for (const ActuatedHinge& hinge : simulation_.character().hinges()) {
-      data->qpos[hinge.qpos_address] += noise(rng_);
-    }
-    simulation_.Refresh();
-  }
   BeginEpisode(view_index, frame);
   ProjectCurrentPoints();
   WriteObservation(observation);

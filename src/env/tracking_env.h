@@ -24,8 +24,10 @@ struct TrackingEnvOptions {
   bool early_exit = true;                  // reprojection early exit on/off
   double early_exit_max_error_px = 100.0;  // worst-keypoint error that ends it
   RewardWeights reward;
-  // "Noisy S.I.": Gaussian noise (rad) added to every hinge angle of an
-  // initial state drawn from the buffer; 0 disables.
+  // Noisy S.I.: sigma (rad) added once to the joint angles of the
+  // initial-state buffers when they are filled; ASI replaces them with
+  // visited states. Read by whoever fills the buffers (the Trainer passes it
+  // to InitialStates), not by the environment; 0 disables.
   double initial_state_noise_rad = 0.0;
 
   int max_episode_steps() const {
@@ -87,6 +89,8 @@ class TrackingEnv {
   // The simulated keypoints projected by the episode's camera at the
   // current frame (x, y per point; valid after Reset/Step).
   const std::vector<double>& projected_px() const { return projected_xy_; }
+  // Per point: whether it is in front of the episode's camera.
+  const bool* in_front() const { return in_front_.get(); }
   // Current observation written again (e.g. after the trainer edits state).
   void WriteObservation(float* observation);
 

@@ -23,12 +23,12 @@ std::vector<EvalRow> EvaluatePolicy(
     std::shared_ptr<const InitialStates> initial_states,
     const TrackingEnvOptions& env_options, const EvalOptions& options) {
   options.Validate();
-  // The evaluation episode: early exit exactly at the success threshold, no
-  // initial-state noise.
+  // The evaluation episode: early exit exactly at the success threshold.
+  // Episodes start from the given initial states (noise-free ones for
+  // evaluation: callers build them with sigma 0).
   TrackingEnvOptions eval_env = env_options;
   eval_env.early_exit = true;
   eval_env.early_exit_max_error_px = options.success_threshold_px;
-  eval_env.initial_state_noise_rad = 0.0;
   eval_env.max_episode_s = options.episode_s;
   TrackingEnv env(character, reference, initial_states, eval_env, 0);
   if (env.observation_size() != policy.observation_size() ||

@@ -122,8 +122,10 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     bundles.push_back(ReadBundle(path));
   s.reference = TrackingReference::Prepare(std::move(bundles), *s.character,
                                            config.env.simulation.control_hz);
+  // Noisy S.I. perturbs the buffers once, here; ASI then replaces states.
   s.initial_states = std::make_shared<InitialStates>(
-      *s.reference, s.character, config.env.simulation, config.asi.buffer);
+      *s.reference, s.character, config.env.simulation, config.asi.buffer,
+      config.env.initial_state_noise_rad, run.seed + 2'000'003);
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);

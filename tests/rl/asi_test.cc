@@ -1,0 +1,156 @@
+// ASI corrects noisy initial states (the paper's Noisy S.I.): a run whose
+// initial-state buffers start with sigma = 0.5 rad of joint noise replaces
+// them by visited states that match the 2D reference better; without ASI
+// the buffers stay as filled.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "env/env_fixture.h"
+#include "env/reward.h"
+#include "motion/bundle.h"
+#include "motion/motion_io.h"
+#include "rl/checkpoint.h"
+#include "rl/trainer.h"
+#include "sim/simulation.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
+constexpr double kNoiseRad = 0.5;  // the paper's Noisy S.I.
+
+// A 1 s walk bundle written into `dir`; 8 envs x 16 steps per iteration,
+// every visited state offered to ASI, tiny networks, and the Learning
+// test's faster learning rate (with the default 2e-4 the policy learns too
+// slowly: 1000 iterations only took the error to 0.84x).
+TrainConfig NoisyConfig(const std::string& walk_path, const std::string& dir,
+                        bool asi_enabled) {
+  TrainConfig config;
+  config.data.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  auto character = LoadCharacterForSimulation(config.data.character_config,
+                                              "flat", config.env.simulation);
+  config.data.bundles = {dir + "/walk1s.json"};
+  WriteBundle(config.data.bundles[0],
+              testing::MakeWalkBundle(walk_path, *character, 1.0));
+  config.env.initial_state_noise_rad = kNoiseRad;
+  config.model.encoder_hidden = {16};
+  config.model.encoder_features = 8;
+  config.model.policy_hidden = {32};
+  config.model.critic_hidden = {32};
+  config.ppo.num_envs = 8;
+  config.ppo.steps_per_env = 16;
+  config.ppo.minibatch_size = 64;
+  config.ppo.epochs = 2;
+  config.ppo.learning_rate = 5e-4;
+  config.asi.enabled = asi_enabled;
+  config.asi.capture_every_steps = 1;
+  config.run.run_dir = dir + "/run";
+  config.run.seed = 5;
+  config.run.env_threads = 1;
+  config.run.checkpoint_minutes = 60.0;  // only the checkpoints asked for
+  config.Validate();
+  return config;
+}
+
+// The mean over frames of the 2D error (px, view 0, mean over keypoints) of
+// each frame's best-scoring initial state: from the checkpoint's buffers,
+// or from noise-free buffers when `checkpoint` is empty.
+double MeanBestStateErrorPx(const TrainConfig& config,
+                            const std::string& checkpoint) {
+  auto character = LoadCharacterForSimulation(
+      config.data.character_config, config.data.scene, config.env.simulation);
+  auto reference =
+      TrackingReference::Prepare({ReadBundle(config.data.bundles[0])},
+                                 *character, config.env.simulation.control_hz);
+  auto states = std::make_shared<InitialStates>(
+      *reference, character, config.env.simulation, config.asi.buffer);
+  TrackingEnv env(character, reference, states, config.env, 0);
+  if (!checkpoint.empty()) {
+    int action_size = 0;
+    ActorCritic model(ReadCheckpointLayout(checkpoint, &action_size),
+                      config.model, action_size);
+    LoadCheckpoint(checkpoint, model, nullptr, states.get(),
+                   env.simulation().Save());
+  }
+  const TrackedView& view = reference->views()[0];
+  const int num_keypoints = character->keypoint_layout().num_keypoints();
+  const StateBuffer& buffer = states->buffer(0);
+  std::vector<float> observation(env.observation_size());
+  double sum_px = 0.0;
+  for (int frame = 0; frame < buffer.num_frames(); ++frame) {
+    env.ResetTo(0, frame, buffer.entry(frame, buffer.Best(frame)).state,
+                observation.data());
+    sum_px += MeasureReprojection(env.projected_px().data(), env.in_front(),
+                                  view.frame(frame), num_keypoints)
+                  .mean_px;
+  }
+  return sum_px / buffer.num_frames();
+}
+
+struct BufferErrors {
+  double as_filled_px = 0.0;  // before the first iteration
+  double trained_px = 0.0;    // after training
+};
+
+BufferErrors TrainAndMeasure(const TrainConfig& config, int iterations) {
+  Trainer trainer(config, /*resume=*/false);
+  trainer.SaveCheckpoint();
+  BufferErrors errors;
+  errors.as_filled_px = MeanBestStateErrorPx(config, trainer.checkpoint_path());
+  TrainSummary summary = trainer.Run(iterations, nullptr, nullptr);
+  EXPECT_EQ(summary.iterations_run, iterations);
+  errors.trained_px = MeanBestStateErrorPx(config, summary.checkpoint_path);
+  return errors;
+}
+
+// Measured on this machine (seed 5, 1000 iterations = 128k samples, 28 s
+// while a training shared the machine): the best states were 0.00 px from
+// the reference without noise, 51.5 px as filled, 21.2 px after training
+// (0.41x). Seeds 6 and 7 gave 46.9 -> 30.8 px (0.66x) and 51.8 -> 29.5 px
+// (0.57x). After 600 iterations seed 5 was at 31.6 px (0.61x): the policy
+// has to learn before its visited states beat the noise.
+constexpr int kIterations = 1000;
+constexpr double kMaxCorrectedRatio = 0.7;
+
+TEST(Asi, CorrectsNoisyInitialStates) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("asi_corrects");
+  const TrainConfig config = NoisyConfig(walk_path, dir, true);
+  const double clean_px = MeanBestStateErrorPx(config, "");
+  BufferErrors errors = TrainAndMeasure(config, kIterations);
+  std::printf(
+      "best initial states, mean 2D error: noise-free %.2f px, as filled "
+      "%.2f px, after %d iterations %.2f px (%.2fx)\n",
+      clean_px, errors.as_filled_px, kIterations, errors.trained_px,
+      errors.trained_px / errors.as_filled_px);
+  // The trainer filled the buffers with noise: far from the reference that
+  // the noise-free states match.
+  EXPECT_LT(clean_px, 2.0);
+  EXPECT_GT(errors.as_filled_px, 20.0);
+  EXPECT_LT(errors.trained_px, kMaxCorrectedRatio * errors.as_filled_px);
+  fs::remove_all(dir);
+}
+
+// Training without ASI leaves the buffers alone, however long it runs (a
+// few iterations show it: nothing else writes to them).
+TEST(Asi, WithoutAsiTheNoisyBuffersStayAsFilled) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("asi_disabled");
+  const TrainConfig config = NoisyConfig(walk_path, dir, false);
+  BufferErrors errors = TrainAndMeasure(config, 50);
+  EXPECT_GT(errors.as_filled_px, 20.0);
+  EXPECT_EQ(errors.trained_px, errors.as_filled_px);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace m2d
