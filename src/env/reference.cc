@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <random>
 
 #include "common/error.h"
@@ -63,43 +62,6 @@ Pose3D PlaceDefaultPose(const Character& character, const Pose3D& standing,
   pose.root_position_m = target - root_offset;
   pose.root_position_m.z() = standing.root_position_m.z();
   return pose;
-}
-
-// The height (m) of the character's lowest colliding point: exact for
-// spheres, capsules, cylinders and boxes, a bounding sphere for other shapes.
-double LowestCharacterPointZ(const Simulation& simulation) {
-  const mjModel* m = simulation.model();
-  const mjData* d = simulation.data();
-  double lowest_m = std::numeric_limits<double>::infinity();
-  for (int g = 0; g < m->ngeom; ++g) {
-    if (!simulation.character().IsCharacterBody(m->geom_bodyid[g])) continue;
-    if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) continue;
-    const double* size = m->geom_size + 3 * g;
-    // Row 2 of the geom's rotation: the world z of its local axes.
-    const double* z_of_axis = d->geom_xmat + 9 * g + 6;
-    const double axis_z = std::abs(z_of_axis[2]);
-    double reach_m = m->geom_rbound[g];
-    switch (m->geom_type[g]) {
-      case mjGEOM_SPHERE:
-        reach_m = size[0];
-        break;
-      case mjGEOM_CAPSULE:
-        reach_m = size[0] + size[1] * axis_z;
-        break;
-      case mjGEOM_CYLINDER:
-        reach_m = size[0] * std::sqrt(std::max(0.0, 1.0 - axis_z * axis_z)) +
-                  size[1] * axis_z;
-        break;
-      case mjGEOM_BOX:
-        reach_m = size[0] * std::abs(z_of_axis[0]) +
-                  size[1] * std::abs(z_of_axis[1]) + size[2] * axis_z;
-        break;
-      default:
-        break;
-    }
-    lowest_m = std::min(lowest_m, d->geom_xpos[3 * g + 2] - reach_m);
-  }
-  return lowest_m;
 }
 
 // Noisy S.I.: adds N(0, sigma) to every actuated hinge angle (kept within

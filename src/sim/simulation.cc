@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "common/error.h"
 #include "sim/pose_mapping.h"
@@ -347,6 +348,41 @@ std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
   for (int j = 0; j < count; ++j)
     points[j] = {xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]};
   return points;
+}
+
+double LowestCharacterPointZ(const Simulation& simulation) {
+  const mjModel* m = simulation.model();
+  const mjData* d = simulation.data();
+  double lowest_m = std::numeric_limits<double>::infinity();
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (!simulation.character().IsCharacterBody(m->geom_bodyid[g])) continue;
+    if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) continue;
+    const double* size = m->geom_size + 3 * g;
+    // Row 2 of the geom's rotation: the world z of its local axes.
+    const double* z_of_axis = d->geom_xmat + 9 * g + 6;
+    const double axis_z = std::abs(z_of_axis[2]);
+    double reach_m = m->geom_rbound[g];
+    switch (m->geom_type[g]) {
+      case mjGEOM_SPHERE:
+        reach_m = size[0];
+        break;
+      case mjGEOM_CAPSULE:
+        reach_m = size[0] + size[1] * axis_z;
+        break;
+      case mjGEOM_CYLINDER:
+        reach_m = size[0] * std::sqrt(std::max(0.0, 1.0 - axis_z * axis_z)) +
+                  size[1] * axis_z;
+        break;
+      case mjGEOM_BOX:
+        reach_m = size[0] * std::abs(z_of_axis[0]) +
+                  size[1] * std::abs(z_of_axis[1]) + size[2] * axis_z;
+        break;
+      default:
+        break;
+    }
+    lowest_m = std::min(lowest_m, d->geom_xpos[3 * g + 2] - reach_m);
+  }
+  return lowest_m;
 }
 
 }  // namespace m2d

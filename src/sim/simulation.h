@@ -132,6 +132,11 @@ class Simulation {
   std::vector<uint8_t> allowed_ground_;  // per body
 };
 
+// The height (m) of the character's lowest colliding point in its current
+// state: exact for spheres, capsules, cylinders and boxes, a bounding sphere
+// for other shapes.
+double LowestCharacterPointZ(const Simulation& simulation);
+
 // The keypoint sites' world positions as points (layout order).
 std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation);
 

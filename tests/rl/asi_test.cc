@@ -18,6 +18,7 @@
 #include "rl/trainer.h"
 #include "sim/simulation.h"
 #include "test_paths.h"
+#include "tiny_walk_config.h"
 
 namespace m2d {
 namespace {
@@ -33,19 +34,8 @@ constexpr double kNoiseRad = 0.5;  // the paper's Noisy S.I.
 // slowly: 1000 iterations only took the error to 0.84x).
 TrainConfig NoisyConfig(const std::string& walk_path, const std::string& dir,
                         bool asi_enabled) {
-  TrainConfig config;
-  config.data.character_config =
-      testing::SourcePath("assets/characters/humanoid.yaml");
-  auto character = LoadCharacterForSimulation(config.data.character_config,
-                                              "flat", config.env.simulation);
-  config.data.bundles = {dir + "/walk1s.json"};
-  WriteBundle(config.data.bundles[0],
-              testing::MakeWalkBundle(walk_path, *character, 1.0));
+  TrainConfig config = testing::TinyWalkConfig(walk_path, dir);
   config.env.initial_state_noise_rad = kNoiseRad;
-  config.model.encoder_hidden = {16};
-  config.model.encoder_features = 8;
-  config.model.policy_hidden = {32};
-  config.model.critic_hidden = {32};
   config.ppo.num_envs = 8;
   config.ppo.steps_per_env = 16;
   config.ppo.minibatch_size = 64;
@@ -53,10 +43,7 @@ TrainConfig NoisyConfig(const std::string& walk_path, const std::string& dir,
   config.ppo.learning_rate = 5e-4;
   config.asi.enabled = asi_enabled;
   config.asi.capture_every_steps = 1;
-  config.run.run_dir = dir + "/run";
   config.run.seed = 5;
-  config.run.env_threads = 1;
-  config.run.checkpoint_minutes = 60.0;  // only the checkpoints asked for
   config.Validate();
   return config;
 }

@@ -17,6 +17,7 @@
 #include "rl/trainer.h"
 #include "sim/simulation.h"
 #include "test_paths.h"
+#include "tiny_walk_config.h"
 
 namespace m2d {
 namespace {
@@ -28,26 +29,12 @@ constexpr char kWalk[] = "deepmimic/motions/humanoid3d_walk.txt";
 // A 1 s walk bundle written into `dir`, and a config training on it with
 // 4 envs x 16 steps (64 samples per iteration) and tiny networks.
 TrainConfig TinyConfig(const std::string& walk_path, const std::string& dir) {
-  TrainConfig config;
-  config.data.character_config =
-      testing::SourcePath("assets/characters/humanoid.yaml");
-  auto character = LoadCharacterForSimulation(config.data.character_config,
-                                              "flat", config.env.simulation);
-  config.data.bundles = {dir + "/walk1s.json"};
-  WriteBundle(config.data.bundles[0],
-              testing::MakeWalkBundle(walk_path, *character, 1.0));
-  config.model.encoder_hidden = {16};
-  config.model.encoder_features = 8;
-  config.model.policy_hidden = {32};
-  config.model.critic_hidden = {32};
+  TrainConfig config = testing::TinyWalkConfig(walk_path, dir);
   config.ppo.num_envs = 4;
   config.ppo.steps_per_env = 16;
   config.ppo.minibatch_size = 32;
   config.ppo.epochs = 1;
-  config.run.run_dir = dir + "/run";
   config.run.seed = 3;
-  config.run.env_threads = 1;
-  config.run.checkpoint_minutes = 60.0;  // only the final checkpoint
   config.Validate();
   return config;
 }
