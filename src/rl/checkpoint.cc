@@ -72,6 +72,10 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
   torch::serialize::OutputArchive optimizer_archive;
   optimizer.save(optimizer_archive);
   archive.write("optimizer", optimizer_archive);
+  archive.write(
+      "learning_rate",
+      torch::tensor(optimizer.param_groups().front().options().get_lr(),
+                    torch::kDouble));
 
   if (initial_states != nullptr) {
     const int64_t width = FlatStateSize(state_template);
@@ -172,10 +176,18 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
     torch::serialize::InputArchive model_archive;
     archive.read("model", model_archive);
     model->load(model_archive);
+    torch::Tensor learning_rate;
+    if (archive.try_read("learning_rate", learning_rate))
+      counters.learning_rate = learning_rate.item<double>();
     if (optimizer != nullptr) {
       torch::serialize::InputArchive optimizer_archive;
       archive.read("optimizer", optimizer_archive);
       optimizer->load(optimizer_archive);
+      if (counters.learning_rate > 0) {
+        for (torch::optim::OptimizerParamGroup& group :
+             optimizer->param_groups())
+          group.options().set_lr(counters.learning_rate);
+      }
     }
     if (initial_states != nullptr) {
       const int64_t width = FlatStateSize(state_template);

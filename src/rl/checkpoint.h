@@ -17,6 +17,10 @@ struct CheckpointCounters {
   int iteration = 0;
   int64_t samples = 0;
   double wall_time_s = 0.0;
+  // Adam's rate when saved (0: not recorded; checkpoints before it was).
+  // LibTorch 1.13's Optimizer::load drops the saved parameter-group options,
+  // so LoadCheckpoint restores the rate itself.
+  double learning_rate = 0.0;
 };
 
 // Writes to a temporary file next to `path` and renames it over `path`.

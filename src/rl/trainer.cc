@@ -33,13 +33,20 @@ constexpr char kLogHeader[] =
     "length,succ,e2d_px,"
     "policy_loss,value_loss,entropy,learning_rate";
 
+// What a resumed run may need from the log's last row.
+struct LastLogRow {
+  double wall_time_s = -1.0;
+  double learning_rate = -1.0;
+};
+
 // Keeps the log rows up to `iteration` (a resumed run rewrites what came
-// after its checkpoint).
-void TrimLog(const std::string& path, int iteration) {
+// after its checkpoint) and returns the last kept row.
+LastLogRow TrimLog(const std::string& path, int iteration) {
   std::ifstream in(path);
   std::ostringstream kept;
   kept << kLogHeader << "\n";
   std::string line;
+  LastLogRow last;
   std::getline(in, line);  // header
   while (std::getline(in, line)) {
     // Rows past the checkpoint, or torn by a kill mid-write, are dropped. A
@@ -47,10 +54,23 @@ void TrimLog(const std::string& path, int iteration) {
     // the number itself short ("1" of "12,..."): hence the comma.
     const int row_iteration = std::atoi(line.c_str());
     const bool whole_iteration = line.find(',') != std::string::npos;
-    if (whole_iteration && row_iteration > 0 && row_iteration <= iteration)
+    if (whole_iteration && row_iteration > 0 && row_iteration <= iteration) {
       kept << line << "\n";
+      // Columns: iteration, samples, wall_time_s, ..., learning_rate.
+      const size_t second_comma = line.find(',', line.find(',') + 1);
+      if (second_comma != std::string::npos)
+        last.wall_time_s = std::atof(line.c_str() + second_comma + 1);
+      last.learning_rate = std::atof(line.c_str() + line.rfind(',') + 1);
+    }
   }
   WriteFileAtomic(path, kept.str());
+  return last;
+}
+
+// Wall times beyond a century are corrupt (checkpoints written before a fix
+// read the double's bits as int64: 4.66e18 s).
+bool PlausibleWallTime(double seconds) {
+  return std::isfinite(seconds) && seconds >= 0 && seconds < 3.2e9;
 }
 
 // A visited state offered to the ASI buffers.
@@ -158,9 +178,12 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
       torch::NoGradGuard no_grad;
       s.model->LogStd().fill_(std::log(config.model.action_std));
     }
+    const LastLogRow last_row = TrimLog(s.log_path, s.counters.iteration);
     // A fixed rate is a setting; an adaptive one is training state and
-    // continues from where it was.
+    // continues from where it was (from the log for older checkpoints).
     if (config.ppo.target_kl > 0) {
+      if (s.counters.learning_rate <= 0 && last_row.learning_rate > 0)
+        s.SetLearningRate(last_row.learning_rate);
       spdlog::info("adaptive learning rate continues at {}", s.LearningRate());
     } else {
       if (std::abs(s.LearningRate() - config.ppo.learning_rate) > 1e-15) {
@@ -169,7 +192,15 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
       }
       s.SetLearningRate(config.ppo.learning_rate);
     }
-    TrimLog(s.log_path, s.counters.iteration);
+    if (!PlausibleWallTime(s.counters.wall_time_s)) {
+      const double repaired_s =
+          PlausibleWallTime(last_row.wall_time_s) ? last_row.wall_time_s : 0.0;
+      spdlog::warn(
+          "{}: wall time {} s is corrupt; continuing from {} s (the "
+          "log's last row)",
+          s.checkpoint_path, s.counters.wall_time_s, repaired_s);
+      s.counters.wall_time_s = repaired_s;
+    }
   } else {
     if (resume)
       spdlog::warn("--resume: no checkpoint at {}; starting fresh",

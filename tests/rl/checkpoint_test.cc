@@ -109,6 +109,9 @@ TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   counters.iteration = 37;
   counters.samples = 123'456'789'012;  // past 2^32
   counters.wall_time_s = 2775.83;      // not an integer
+  // An adapted rate (target_kl): fresh optimizers start at 1e-3.
+  for (auto& group : saved.optimizer->param_groups())
+    group.options().set_lr(1.75e-5);
   SaveCheckpoint(path, config, saved.model, *saved.optimizer, counters, nullptr,
                  SimState());
 
@@ -122,6 +125,10 @@ TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   EXPECT_EQ(read.iteration, 37);
   EXPECT_EQ(read.samples, 123'456'789'012);
   EXPECT_EQ(read.wall_time_s, 2775.83);  // exactly: stored as a double
+  // LibTorch's Optimizer::load alone would leave the fresh 1e-3.
+  EXPECT_EQ(read.learning_rate, 1.75e-5);
+  for (const auto& group : loaded.optimizer->param_groups())
+    EXPECT_EQ(group.options().get_lr(), 1.75e-5);
 
   // Weights and the observation normalizer's running statistics.
   EXPECT_TRUE(SameTensors(saved.model->named_parameters(),

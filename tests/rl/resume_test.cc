@@ -211,5 +211,52 @@ TEST(Resume, AFixedActionStdFollowsTheConfig) {
   fs::remove_all(dir);
 }
 
+TEST(Resume, AnAdaptiveLearningRateContinuesFromTheCheckpoint) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_adaptive_lr");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.target_kl = 0.01;
+  config.ppo.learning_rate = 2e-4;
+  RunResult first = TrainIterations(config, /*resume=*/false, 2);
+  const CheckpointCounters saved = ReadCounters(first.summary.checkpoint_path);
+  ASSERT_GT(saved.learning_rate, 0.0);
+
+  // The config's rate is only the first iteration's: a resumed run goes on
+  // with the adapted one.
+  config.ppo.learning_rate = 7e-4;
+  RunResult second = TrainIterations(config, /*resume=*/true, 1);
+  ASSERT_EQ(second.progress.size(), 1u);
+  EXPECT_EQ(second.progress[0].learning_rate, saved.learning_rate);
+  fs::remove_all(dir);
+}
+
+TEST(Resume, ACorruptWallTimeContinuesFromTheLog) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_corrupt_wall_time");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  RunResult first = TrainIterations(config, /*resume=*/false, 2);
+  const std::string checkpoint = first.summary.checkpoint_path;
+
+  // Rewrite the checkpoint with the counter a fixed bug produced (a double's
+  // bits read as int64), keeping everything else.
+  TrainConfig saved_config = ReadCheckpointConfig(checkpoint);
+  int action_size = 0;
+  ObservationLayout layout = ReadCheckpointLayout(checkpoint, &action_size);
+  ActorCritic model(layout, saved_config.model, action_size);
+  torch::optim::Adam optimizer(model->parameters(), 1e-3);
+  CheckpointCounters counters =
+      LoadCheckpoint(checkpoint, model, &optimizer, nullptr, SimState());
+  counters.wall_time_s = 4.658e18;
+  SaveCheckpoint(checkpoint, saved_config, model, optimizer, counters, nullptr,
+                 SimState());
+
+  const double logged_s = ReadLog(config.run.run_dir).back().wall_time_s;
+  RunResult second = TrainIterations(config, /*resume=*/true, 1);
+  ASSERT_EQ(second.progress.size(), 1u);
+  EXPECT_GT(second.progress[0].wall_time_s, logged_s);
+  EXPECT_LE(second.progress[0].wall_time_s, logged_s + second.elapsed_s);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace m2d
