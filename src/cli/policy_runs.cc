@@ -48,16 +48,26 @@ nlohmann::json RowToJson(const EvalRow& row) {
   auto optional = [](double v) {
     return v < 0 ? nlohmann::json() : nlohmann::json(v);
   };
-  return {{"clip", row.bundle},
-          {"view", row.view},
-          {"episodes", row.episodes},
-          {"succ", row.succ},
-          {"e2d_px", row.e2d_px},
-          {"eo2d_px", optional(row.eo2d_px)},
-          {"e3d_mm", optional(row.e3d_mm)},
-          {"e3d_root_mm", optional(row.e3d_root_mm)},
-          {"jitter", row.jitter},
-          {"mean_frames", row.mean_frames}};
+  nlohmann::json json = {{"clip", row.bundle},
+                         {"view", row.view},
+                         {"episodes", row.episodes},
+                         {"succ", row.succ},
+                         {"e2d_px", row.e2d_px},
+                         {"eo2d_px", optional(row.eo2d_px)},
+                         {"e3d_mm", optional(row.e3d_mm)},
+                         {"e3d_root_mm", optional(row.e3d_root_mm)},
+                         {"jitter", row.jitter},
+                         {"mean_frames", row.mean_frames}};
+  if (!row.rollouts.empty()) {
+    json["rollouts"] = nlohmann::json::array();
+    for (const EvalRollout& rollout : row.rollouts) {
+      json["rollouts"].push_back({{"start_frame", rollout.start_frame},
+                                  {"frames", rollout.frames},
+                                  {"succeeded", rollout.succeeded},
+                                  {"e2d_px", rollout.e2d_px}});
+    }
+  }
+  return json;
 }
 
 }  // namespace

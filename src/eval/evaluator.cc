@@ -97,6 +97,8 @@ std::vector<EvalRow> EvaluatePolicy(
         if (outcome.terminated || outcome.truncated) break;
       }
       const EpisodeStats& stats = env.episode();
+      row.rollouts.push_back(
+          {start, stats.steps, !stats.failed, stats.mean_error_px()});
       succ += stats.failed ? 0.0 : 1.0;
       e2d += stats.mean_error_px();
       frames += stats.steps;

@@ -14,11 +14,19 @@
 namespace m2d {
 
 struct EvalOptions {
-  int episodes_per_view = 4;            // start frames spread over the clip
+  int episodes_per_view = 10;           // start frames spread over the clip
   double episode_s = 10.0;              // episode length (clip end cuts it)
   double success_threshold_px = 100.0;  // a frame whose worst keypoint is off
                                         // by more fails the rollout
   void Validate() const;                // throws ConfigError
+};
+
+// One evaluation rollout (to find which start fails).
+struct EvalRollout {
+  int start_frame = 0;
+  int frames = 0;  // until the first failing frame or the end
+  bool succeeded = false;
+  double e2d_px = 0.0;
 };
 
 struct EvalRow {
@@ -32,6 +40,7 @@ struct EvalRow {
   double e3d_root_mm = -1.0;  // root-relative 3D error; -1 without truth
   double jitter = 0.0;        // 10^3 m/s^3
   double mean_frames = 0.0;   // frames rolled out per episode
+  std::vector<EvalRollout> rollouts;  // empty in aggregates
 };
 
 // Episodes start from each frame's best-scoring initial state, use the

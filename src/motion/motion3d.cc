@@ -79,17 +79,59 @@ double HeadingAngle(const Eigen::Quaterniond& rotation) {
   return std::atan2(forward.y(), forward.x());
 }
 
-Motion3D ExtendLoop(const Motion3D& motion, double duration_s) {
-  if (!motion.loops || motion.num_frames() < 2) return motion;
+namespace {
+
+// Recorded cycles rarely close exactly: the DeepMimic walk's last frame
+// misses its first by 0.50 rad at the right shoulder, a one-frame jump at
+// every seam (and a wild velocity for a state initialized there). Spreads
+// each rotation's mismatch, and the root height's, linearly over the cycle
+// so that the last frame repeats the first up to the heading `cycle_turn`
+// that ExtendLoop accumulates.
+Motion3D CloseLoopSeam(const Motion3D& motion,
+                       const Eigen::Quaterniond& cycle_turn) {
+  Motion3D closed = motion;
+  const Pose3D& first = motion.frames.front();
+  const Pose3D& last = motion.frames.back();
+  const int num_rotations = static_cast<int>(first.local_rotations.size());
+  std::vector<Eigen::Quaterniond> mismatch(num_rotations);
+  for (int j = 0; j < num_rotations; ++j) {
+    Eigen::Quaterniond target = first.local_rotations[j];
+    if (j == 0) target = cycle_turn * target;  // the root turns every cycle
+    mismatch[j] = (target * last.local_rotations[j].inverse()).normalized();
+  }
+  const double height_mismatch_m =
+      first.root_position_m.z() - last.root_position_m.z();
+  const int n = motion.num_frames();
+  for (int i = 1; i < n; ++i) {
+    const double t = static_cast<double>(i) / (n - 1);
+    Pose3D& pose = closed.frames[i];
+    for (int j = 0; j < num_rotations; ++j) {
+      pose.local_rotations[j] =
+          (Eigen::Quaterniond::Identity().slerp(t, mismatch[j]) *
+           pose.local_rotations[j])
+              .normalized();
+    }
+    pose.root_position_m.z() += t * height_mismatch_m;
+  }
+  return closed;
+}
+
+}  // namespace
+
+Motion3D ExtendLoop(const Motion3D& looping_motion, double duration_s) {
+  if (!looping_motion.loops || looping_motion.num_frames() < 2 ||
+      looping_motion.duration_s() >= duration_s)
+    return looping_motion;
   // One cycle spans frames [0, n-1]; frame n-1 is frame 0 of the next cycle.
   // The cycle's net motion is the heading turn and horizontal shift from
   // frame 0 to frame n-1; each repetition applies it once more.
-  const Pose3D& first = motion.frames.front();
-  const Pose3D& last = motion.frames.back();
-  double turn = HeadingAngle(last.local_rotations[0]) -
-                HeadingAngle(first.local_rotations[0]);
+  double turn = HeadingAngle(looping_motion.frames.back().local_rotations[0]) -
+                HeadingAngle(looping_motion.frames.front().local_rotations[0]);
   Eigen::Quaterniond cycle_turn(
       Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()));
+  const Motion3D motion = CloseLoopSeam(looping_motion, cycle_turn);
+  const Pose3D& first = motion.frames.front();
+  const Pose3D& last = motion.frames.back();
 
   Motion3D out = motion;
   Eigen::Quaterniond turn_so_far = Eigen::Quaterniond::Identity();

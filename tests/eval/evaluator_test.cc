@@ -52,8 +52,19 @@ TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
     EXPECT_GE(row.e3d_root_mm, 0.0);
     EXPECT_EQ(row.eo2d_px, -1.0);
     EXPECT_TRUE(std::isfinite(row.jitter));
+    // Each rollout is reported: where it started and when it failed.
+    ASSERT_EQ(row.rollouts.size(), 2u);
+    double frames = 0;
+    for (const EvalRollout& rollout : row.rollouts) {
+      EXPECT_FALSE(rollout.succeeded);
+      frames += rollout.frames;
+    }
+    EXPECT_DOUBLE_EQ(frames / 2, row.mean_frames);
+    EXPECT_EQ(row.rollouts[0].start_frame, 0);
+    EXPECT_GT(row.rollouts[1].start_frame, 0);
   }
   EvalRow all = AggregateRows(rows);
+  EXPECT_TRUE(all.rollouts.empty());
   EXPECT_EQ(all.episodes, 2 * static_cast<int>(rows.size()));
   EXPECT_EQ(all.succ, 0.0);
 }
@@ -76,6 +87,15 @@ TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
     EXPECT_EQ(row.mean_frames, 15.0);  // 0.5 s at 30 Hz, truncated
     EXPECT_TRUE(std::isfinite(row.e2d_px));
     EXPECT_GT(row.e2d_px, 0.0);
+    // Starts spread from the first frame to the last that leaves a whole
+    // episode (61 frames: 0, 22, 45).
+    ASSERT_EQ(row.rollouts.size(), 3u);
+    const int starts[] = {0, 22, 45};
+    for (int e = 0; e < 3; ++e) {
+      EXPECT_EQ(row.rollouts[e].start_frame, starts[e]);
+      EXPECT_EQ(row.rollouts[e].frames, 15);
+      EXPECT_TRUE(row.rollouts[e].succeeded);
+    }
   }
   // The policy ignores what it observes, so every view rolls out the same
   // motion from the same start frames: the 3D metrics, which never look

@@ -97,6 +97,50 @@ TEST(DeepMimicReader, ExtendLoopContinuesWithoutJumps) {
   EXPECT_GT(distance, 8.0);
 }
 
+// Largest frame-to-frame rotation (rad) of joint `j` between frames
+// [begin, end).
+double MaxJointStep(const Motion3D& motion, size_t j, int begin, int end) {
+  double step = 0;
+  for (int i = std::max(begin, 1); i < end; ++i) {
+    step =
+        std::max(step, motion.frames[i - 1].local_rotations[j].angularDistance(
+                           motion.frames[i].local_rotations[j]));
+  }
+  return step;
+}
+
+TEST(DeepMimicReader, ExtendLoopClosesTheCycleSeam) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  Motion3D motion = ReadDeepMimicMotion(path, Humanoid());
+  const int n = motion.num_frames();
+  const size_t num_rotations = motion.frames[0].local_rotations.size();
+  // The recorded cycle does not close: some joint's last frame is far from
+  // its first (the right shoulder: 0.50 rad, twice its largest step).
+  double worst_excess = 0;
+  for (size_t j = 1; j < num_rotations; ++j) {
+    const double seam = motion.frames[0].local_rotations[j].angularDistance(
+        motion.frames[n - 1].local_rotations[j]);
+    worst_excess = std::max(worst_excess, seam - MaxJointStep(motion, j, 1, n));
+  }
+  ASSERT_GT(worst_excess, 0.2);
+
+  // Repeated, each joint steps no further across a seam than inside the
+  // recorded cycle (the mismatch spread over 38 frames adds ~0.013 rad).
+  Motion3D looped = ExtendLoop(motion, 10.0);
+  for (size_t j = 0; j < num_rotations; ++j) {
+    const double cycle_step = MaxJointStep(motion, j, 1, n);
+    for (int seam = n - 1; seam + 1 < looped.num_frames(); seam += n - 1) {
+      EXPECT_LT(MaxJointStep(looped, j, seam, seam + 2), cycle_step + 0.03)
+          << "joint " << j << ", seam at frame " << seam;
+    }
+  }
+  // The first frame is the recording's own.
+  for (size_t j = 0; j < num_rotations; ++j) {
+    EXPECT_TRUE(looped.frames[0].local_rotations[j].isApprox(
+        motion.frames[0].local_rotations[j]));
+  }
+}
+
 TEST(DeepMimicReader, ResampleKeepsSpanAndEndpoints) {
   M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
   Motion3D motion = ReadDeepMimicMotion(path, Humanoid());
