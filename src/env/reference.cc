@@ -206,11 +206,17 @@ InitialStates::InitialStates(const TrackingReference& reference,
       simulation.Reset();
       if (has_poses) {
         const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
-        int next = std::min(t + 1, bundle.num_frames() - 1);
-        int previous = next == t ? t - 1 : t;
+        // Central differences (one-sided at the ends): second-order
+        // accurate, and a one-frame glitch in the recording (the DeepMimic
+        // walk's mirrored half-cycles meet with a 0.5 rad shoulder jump)
+        // gives half the spurious velocity of a forward difference.
+        const int previous = std::max(t - 1, 0);
+        const int next = std::min(t + 1, bundle.num_frames() - 1);
         std::fill(qvel.begin(), qvel.end(), 0.0);
-        QvelFromPoses(*character, poses[previous], poses[next], dt_s,
-                      qvel.data());
+        if (next > previous) {
+          QvelFromPoses(*character, poses[previous], poses[next],
+                        (next - previous) * dt_s, qvel.data());
+        }
         simulation.SetPose(poses[t], qvel.data());
       } else {
         simulation.SetPose(
