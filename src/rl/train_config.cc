@@ -49,6 +49,11 @@ void PpoOptions::Validate() const {
   if (!(max_grad_norm > 0))
     throw ConfigError("agent.max_grad_norm must be > 0");
   if (torch_threads < 1) throw ConfigError("agent.torch_threads must be >= 1");
+  if (adapt_torch_threads && torch_threads < 2) {
+    throw ConfigError(
+        "agent.adapt_torch_threads needs agent.torch_threads >= 2 (it "
+        "chooses between 1 and torch_threads)");
+  }
 }
 
 void AsiOptions::Validate() const {
@@ -160,6 +165,7 @@ TrainConfig ParseTrainConfig(const YAML::Node& node,
   agent.Optional("action_bound_weight", &p.action_bound_weight);
   agent.Optional("normalize_observations", &p.normalize_observations);
   agent.Optional("torch_threads", &p.torch_threads);
+  agent.Optional("adapt_torch_threads", &p.adapt_torch_threads);
   agent.RejectUnknownKeys();
 
   YamlSection asi = OpenSection(root, node, "asi", yaml_path, &files, &source);
@@ -271,6 +277,8 @@ std::string TrainConfigToYaml(const TrainConfig& config) {
   out << YAML::Key << "normalize_observations" << YAML::Value
       << p.normalize_observations;
   out << YAML::Key << "torch_threads" << YAML::Value << p.torch_threads;
+  out << YAML::Key << "adapt_torch_threads" << YAML::Value
+      << p.adapt_torch_threads;
   out << YAML::EndMap;
 
   out << YAML::Key << "asi" << YAML::Value << YAML::BeginMap;

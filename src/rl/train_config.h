@@ -57,6 +57,10 @@ struct PpoOptions {
   double action_bound_weight = 10.0;   // penalty on means beyond [-1, 1]
   bool normalize_observations = true;  // running mean/std, saved with model
   int torch_threads = 1;  // LibTorch intra-op threads; 1 measured fastest here
+  // Probe 1 thread against torch_threads while training and keep the faster
+  // (rl/thread_tuner.h): more threads collapse when another process competes
+  // for the cores.
+  bool adapt_torch_threads = false;
 
   int batch_size() const { return num_envs * steps_per_env; }
   void Validate() const;

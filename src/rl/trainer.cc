@@ -18,6 +18,7 @@
 #include "motion/bundle.h"
 #include "rl/checkpoint.h"
 #include "rl/ppo.h"
+#include "rl/thread_tuner.h"
 
 namespace m2d {
 namespace {
@@ -96,6 +97,8 @@ struct Trainer::State {
   std::mt19937_64 rng;
   SimState state_template;
   CheckpointCounters counters;
+  int torch_threads = 1;
+  std::unique_ptr<ThreadTuner> thread_tuner;  // with adapt_torch_threads
   std::vector<CapturedState> captured;
   std::vector<float> captured_observations;
 
@@ -128,7 +131,13 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   std::filesystem::create_directories(run.run_dir);
   s.log_path = run.run_dir + "/train_log.csv";
   s.checkpoint_path = run.run_dir + "/checkpoint.pt";
-  at::set_num_threads(config.ppo.torch_threads);
+  s.torch_threads = config.ppo.torch_threads;
+  at::set_num_threads(s.torch_threads);
+  if (config.ppo.adapt_torch_threads) {
+    ThreadTunerOptions tuner;
+    tuner.max_threads = config.ppo.torch_threads;
+    s.thread_tuner = std::make_unique<ThreadTuner>(tuner);
+  }
   torch::manual_seed(run.seed);
   s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
   s.rng.seed(run.seed);
@@ -363,6 +372,14 @@ TrainSummary Trainer::Run(
       break;
     }
     if (max_iterations > 0 && summary.iterations_run >= max_iterations) break;
+    // 0. LibTorch's thread count (adaptive: the tuner's pick or probe).
+    if (s.thread_tuner) {
+      const int threads = s.thread_tuner->ThreadsForNextIteration();
+      if (threads != s.torch_threads) {
+        s.torch_threads = threads;
+        at::set_num_threads(threads);
+      }
+    }
     // 1. Collect a batch of experience.
     Clock::time_point start = Clock::now();
     std::vector<FinishedEpisode> finished;
@@ -378,6 +395,19 @@ TrainSummary Trainer::Run(
           AdaptLearningRate(learning_rate, losses.approx_kl, config.ppo));
     }
     double update_s = SecondsSince(update_start);
+    if (s.thread_tuner) {
+      const int previous = s.thread_tuner->chosen_threads();
+      const double previous_s = s.thread_tuner->chosen_seconds_per_sample();
+      if (s.thread_tuner->Record(
+              s.torch_threads,
+              (collect_s + update_s) / config.ppo.batch_size())) {
+        spdlog::info(
+            "LibTorch threads {} -> {}: {:.0f} -> {:.0f} samples/s (collect + "
+            "update)",
+            previous, s.torch_threads, 1.0 / previous_s,
+            1.0 / s.thread_tuner->chosen_seconds_per_sample());
+      }
+    }
     // 3. Refresh the initial-state buffers (ASI).
     Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;
@@ -396,6 +426,7 @@ TrainSummary Trainer::Run(
     progress.collect_s = collect_s;
     progress.update_s = update_s;
     progress.asi_s = asi_s;
+    progress.torch_threads = s.torch_threads;
     if (!finished.empty()) {
       double returns = 0, lengths = 0, successes = 0, errors = 0;
       for (const FinishedEpisode& episode : finished) {

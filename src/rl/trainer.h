@@ -28,6 +28,7 @@ struct TrainProgress {
   double clip_fraction = 0.0;  // and the share of clipped ratios
   double learning_rate = 0.0;
   double collect_s = 0.0, update_s = 0.0, asi_s = 0.0;  // time split
+  int torch_threads = 1;  // LibTorch threads this iteration ran with
 };
 
 struct TrainSummary {

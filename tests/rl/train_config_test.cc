@@ -21,7 +21,7 @@ TEST(TrainConfig, ReadsSectionsInlineOrFromFilesAndRoundTrips) {
   std::string dir = testing::TempDir("train_config");
   Write(dir, "agent.yaml",
         "num_envs: 8\nsteps_per_env: 16\nminibatch_size: 64\n"
-        "target_kl: 0.02\n");
+        "target_kl: 0.02\ntorch_threads: 2\nadapt_torch_threads: true\n");
   std::string path =
       Write(dir, "config.yaml",
             "data: {bundles: [a.json]}\n"
@@ -32,6 +32,7 @@ TEST(TrainConfig, ReadsSectionsInlineOrFromFilesAndRoundTrips) {
   EXPECT_EQ(config.ppo.num_envs, 8);
   EXPECT_EQ(config.ppo.minibatch_size, 64);
   EXPECT_DOUBLE_EQ(config.ppo.target_kl, 0.02);
+  EXPECT_TRUE(config.ppo.adapt_torch_threads);
   EXPECT_EQ(config.env.num_future_frames, 3);
   EXPECT_DOUBLE_EQ(config.env.reward.pose_alpha_per_px, 0.01);
   EXPECT_EQ(config.run.seed, 9u);
@@ -75,6 +76,9 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
       "minibatch_size");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: {target_kl: -1}\n",
                     "target_kl");
+  ExpectConfigError(
+      "data: {bundles: [a.json]}\nagent: {adapt_torch_threads: true}\n",
+      "adapt_torch_threads");
   ExpectConfigError(
       "data: {bundles: [a.json]}\n"
       "agent: {learning_rate_min: 0.01, learning_rate_max: 0.001}\n",
