@@ -32,7 +32,17 @@ double SecondsSince(Clock::time_point start) {
 constexpr char kLogHeader[] =
     "iteration,samples,wall_time_s,samples_per_s,mean_return,mean_episode_"
     "length,succ,e2d_px,"
-    "policy_loss,value_loss,entropy,learning_rate";
+    "policy_loss,value_loss,entropy,learning_rate,approx_kl,clip_fraction,"
+    "torch_threads";
+
+std::vector<std::string> SplitFields(const std::string& row) {
+  std::vector<std::string> fields;
+  std::istringstream in(row);
+  std::string field;
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!row.empty() && row.back() == ',') fields.emplace_back();
+  return fields;
+}
 
 // What a resumed run may need from the log's last row.
 struct LastLogRow {
@@ -41,11 +51,13 @@ struct LastLogRow {
 };
 
 // Keeps the log rows up to `iteration` (a resumed run rewrites what came
-// after its checkpoint) and returns the last kept row.
+// after its checkpoint) and returns the last kept row. Rows of a log written
+// before columns were added get empty cells for them (missing values).
 LastLogRow TrimLog(const std::string& path, int iteration) {
   std::ifstream in(path);
   std::ostringstream kept;
   kept << kLogHeader << "\n";
+  const size_t num_columns = SplitFields(kLogHeader).size();
   std::string line;
   LastLogRow last;
   std::getline(in, line);  // header
@@ -56,12 +68,14 @@ LastLogRow TrimLog(const std::string& path, int iteration) {
     const int row_iteration = std::atoi(line.c_str());
     const bool whole_iteration = line.find(',') != std::string::npos;
     if (whole_iteration && row_iteration > 0 && row_iteration <= iteration) {
-      kept << line << "\n";
-      // Columns: iteration, samples, wall_time_s, ..., learning_rate.
-      const size_t second_comma = line.find(',', line.find(',') + 1);
-      if (second_comma != std::string::npos)
-        last.wall_time_s = std::atof(line.c_str() + second_comma + 1);
-      last.learning_rate = std::atof(line.c_str() + line.rfind(',') + 1);
+      const std::vector<std::string> fields = SplitFields(line);
+      kept << line;
+      for (size_t c = fields.size(); c < num_columns; ++c) kept << ',';
+      kept << "\n";
+      // Columns 2 and 11: wall_time_s and learning_rate.
+      if (fields.size() > 2) last.wall_time_s = std::atof(fields[2].c_str());
+      if (fields.size() > 11)
+        last.learning_rate = std::atof(fields[11].c_str());
     }
   }
   WriteFileAtomic(path, kept.str());
@@ -452,7 +466,9 @@ TrainSummary Trainer::Run(
         << progress.mean_return << ',' << progress.mean_episode_length << ','
         << progress.succ << ',' << progress.e2d_px << ','
         << progress.policy_loss << ',' << progress.value_loss << ','
-        << progress.entropy << ',' << progress.learning_rate << '\n';
+        << progress.entropy << ',' << progress.learning_rate << ','
+        << progress.approx_kl << ',' << progress.clip_fraction << ','
+        << progress.torch_threads << '\n';
     log.flush();
     if (on_progress) on_progress(progress);
     summary.last = progress;

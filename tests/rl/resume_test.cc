@@ -2,6 +2,7 @@
 // the checkpoint. Tiny networks and batches: only the bookkeeping matters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -185,6 +186,50 @@ TEST(Resume, DropsLogRowsPastTheCheckpoint) {
     EXPECT_EQ(log[i].iteration, i + 1);
     EXPECT_EQ(log[i].samples, (i + 1) * kBatch);
   }
+  fs::remove_all(dir);
+}
+
+TEST(Resume, RowsOfAnOlderLogGetEmptyCellsForNewColumns) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_old_log");
+  const TrainConfig config = TinyConfig(walk_path, dir);
+  TrainIterations(config, /*resume=*/false, 2);
+  // Rewrite the log as the trainer wrote it before the last three columns.
+  const std::string log_path = config.run.run_dir + "/train_log.csv";
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(log_path);
+    std::string line;
+    while (std::getline(in, line)) {
+      size_t cut = 0;
+      for (int comma = 0; comma < 12 && cut != std::string::npos; ++comma)
+        cut = line.find(',', cut + (comma > 0));
+      lines.push_back(line.substr(0, cut));
+    }
+  }
+  ASSERT_EQ(lines.size(), 3u);
+  ASSERT_EQ(std::count(lines[1].begin(), lines[1].end(), ','), 11);
+  {
+    std::ofstream out(log_path);
+    for (const std::string& line : lines) out << line << "\n";
+  }
+
+  TrainIterations(config, /*resume=*/true, 1);
+  std::ifstream in(log_path);
+  std::string header, row;
+  std::getline(in, header);
+  EXPECT_NE(header.find(",approx_kl,clip_fraction,torch_threads"),
+            std::string::npos)
+      << header;
+  std::vector<std::string> rows;
+  while (std::getline(in, row)) rows.push_back(row);
+  ASSERT_EQ(rows.size(), 3u);
+  for (const std::string& r : rows)
+    EXPECT_EQ(std::count(r.begin(), r.end(), ','), 14) << r;
+  // The old rows' new cells are empty; the new row fills them.
+  EXPECT_EQ(rows[0].substr(rows[0].size() - 3), ",,,");
+  EXPECT_EQ(rows[1].substr(rows[1].size() - 3), ",,,");
+  EXPECT_NE(rows[2].back(), ',');
   fs::remove_all(dir);
 }
 
