@@ -4,6 +4,7 @@
 #include <ATen/Parallel.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -57,7 +58,13 @@ LastLogRow TrimLog(const std::string& path, int iteration) {
   std::ifstream in(path);
   std::ostringstream kept;
   kept << kLogHeader << "\n";
-  const size_t num_columns = SplitFields(kLogHeader).size();
+  const std::vector<std::string> columns = SplitFields(kLogHeader);
+  auto column = [&](const char* name) {
+    return static_cast<size_t>(std::find(columns.begin(), columns.end(), name) -
+                               columns.begin());
+  };
+  const size_t wall_time_column = column("wall_time_s");
+  const size_t learning_rate_column = column("learning_rate");
   std::string line;
   LastLogRow last;
   std::getline(in, line);  // header
@@ -70,12 +77,12 @@ LastLogRow TrimLog(const std::string& path, int iteration) {
     if (whole_iteration && row_iteration > 0 && row_iteration <= iteration) {
       const std::vector<std::string> fields = SplitFields(line);
       kept << line;
-      for (size_t c = fields.size(); c < num_columns; ++c) kept << ',';
+      for (size_t c = fields.size(); c < columns.size(); ++c) kept << ',';
       kept << "\n";
-      // Columns 2 and 11: wall_time_s and learning_rate.
-      if (fields.size() > 2) last.wall_time_s = std::atof(fields[2].c_str());
-      if (fields.size() > 11)
-        last.learning_rate = std::atof(fields[11].c_str());
+      if (fields.size() > wall_time_column)
+        last.wall_time_s = std::atof(fields[wall_time_column].c_str());
+      if (fields.size() > learning_rate_column)
+        last.learning_rate = std::atof(fields[learning_rate_column].c_str());
     }
   }
   WriteFileAtomic(path, kept.str());
@@ -118,14 +125,11 @@ struct Trainer::State {
 
   // Adam's rate, kept in its parameter groups (and so in checkpoints).
   double LearningRate() const {
-    return static_cast<const torch::optim::AdamOptions&>(
-               optimizer->param_groups().front().options())
-        .lr();
+    return optimizer->param_groups().front().options().get_lr();
   }
   void SetLearningRate(double learning_rate) {
     for (torch::optim::OptimizerParamGroup& group : optimizer->param_groups())
-      static_cast<torch::optim::AdamOptions&>(group.options())
-          .lr(learning_rate);
+      group.options().set_lr(learning_rate);
   }
   torch::Tensor Normalized(const torch::Tensor& raw) {
     return config.ppo.normalize_observations ? model->Normalize(raw) : raw;
