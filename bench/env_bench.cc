@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "env/reference.h"
+#include "env/task.h"
 #include "env/tracking_env.h"
 #include "env/vec_env.h"
 #include "motion/bundle.h"
@@ -55,8 +56,7 @@ struct BenchTask {
     return span > 0 ? (7 * episode) % span : 0;
   }
   const SimState& start_state(int episode) const {
-    const TrackedView& tracked = reference->views()[view(episode)];
-    return initial_states->buffer(tracked.bundle)
+    return initial_states->BufferOfView(view(episode))
         .entry(start_frame(episode), 0)
         .state;
   }
@@ -89,11 +89,12 @@ BenchTask MakeBenchTask() {
   bundles.push_back(MakeBundleFromMotion(
       LoadMotion(*task.character, task.options.simulation.control_hz),
       task.character->keypoint_map(), bundle_options, "bench"));
-  task.reference = TrackingReference::Prepare(
-      std::move(bundles), *task.character, task.options.simulation.control_hz);
-  task.initial_states = std::make_shared<InitialStates>(
-      *task.reference, task.character, task.options.simulation,
-      StateBufferOptions());
+  TrackingTaskOptions task_options;
+  task_options.simulation = task.options.simulation;
+  TrackingTask built =
+      BuildTrackingTask(task.character, std::move(bundles), task_options);
+  task.reference = built.reference;
+  task.initial_states = built.initial_states;
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   task.actions.resize(static_cast<size_t>(kActionRows) *

@@ -25,6 +25,7 @@
 
 #ifdef MIMIC2D_HAVE_SIM
 #include "env/reference.h"
+#include "env/task.h"
 #include "env/tracking_env.h"
 #include "env/vec_env.h"
 #include "motion/bundle.h"
@@ -184,11 +185,12 @@ Task MakeTask(const BenchEnvOptions& options) {
                   : "the default standing pose held still (shared motion "
                     "data absent: " +
                         options.motion + ")";
-  task.reference = TrackingReference::Prepare(
-      std::move(bundles), *task.character, task.options.simulation.control_hz);
-  task.initial_states = std::make_shared<InitialStates>(
-      *task.reference, task.character, task.options.simulation,
-      StateBufferOptions());
+  TrackingTaskOptions task_options;
+  task_options.simulation = task.options.simulation;
+  TrackingTask built =
+      BuildTrackingTask(task.character, std::move(bundles), task_options);
+  task.reference = built.reference;
+  task.initial_states = built.initial_states;
   return task;
 }
 
@@ -726,6 +728,7 @@ void AddBenchCommand(CLI::App& app, CommandRun* run) {
   env->callback(
       [run, options] { *run = [options] { return RunBenchEnv(*options); }; });
   AddBenchTrainSubcommand(bench, run);
+  AddBenchFitSubcommand(bench, run);
 }
 
 }  // namespace m2d::cli

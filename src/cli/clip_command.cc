@@ -57,6 +57,24 @@ int RunConvert(const ConvertArgs& args) {
   return 0;
 }
 
+struct StripArgs {
+  std::string input;
+  std::string output;
+};
+
+int RunStrip(const StripArgs& args) {
+  ReferenceBundle bundle = ReadBundle(args.input);
+  const bool had_truth = bundle.ground_truth.has_value();
+  const bool had_estimate = bundle.estimate.has_value();
+  bundle = StripBundle(std::move(bundle));
+  WriteBundle(args.output, bundle);
+  std::cout << "dropped" << (had_truth ? " the 3D ground truth," : "")
+            << " the true cameras" << (had_estimate ? ", the estimate" : "")
+            << "; kept the 2D of " << bundle.views.size() << " views\n";
+  PrintBundleSummary(bundle, args.output);
+  return 0;
+}
+
 int RunInfo(const std::string& path) {
   nlohmann::json json = ReadJsonFile(path);
   if (json.is_object() && json.value("format", "") == kBundleFormat) {
@@ -123,6 +141,18 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
                           "Image height (px)");
   convert_cmd->callback(
       [run, convert] { *run = [convert] { return RunConvert(*convert); }; });
+
+  auto strip = std::make_shared<StripArgs>();
+  CLI::App* strip_cmd = clip->add_subcommand(
+      "strip",
+      "Drop a bundle's 3D ground truth, true cameras and any estimate, "
+      "keeping the 2D (what a user with videos has)");
+  strip_cmd->add_option("bundle", strip->input, "Bundle JSON to strip")
+      ->required();
+  strip_cmd->add_option("-o,--output", strip->output, "Bundle file to write")
+      ->required();
+  strip_cmd->callback(
+      [run, strip] { *run = [strip] { return RunStrip(*strip); }; });
 
   auto info_path = std::make_shared<std::string>();
   CLI::App* info = clip->add_subcommand("info", "Summarize a clip or a bundle");

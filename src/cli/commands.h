@@ -19,9 +19,12 @@ void AddPlotCommand(CLI::App& app, CommandRun* run);
 void AddReportCommand(CLI::App& app, CommandRun* run);
 void AddTrainCommand(CLI::App& app, CommandRun* run);
 void AddEvalCommand(CLI::App& app, CommandRun* run);
+void AddFitCommand(CLI::App& app, CommandRun* run);
 void AddBenchCommand(CLI::App& app, CommandRun* run);
 // `bench train`, registered by AddBenchCommand on its `bench` subcommand.
 void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run);
+// `bench fit`, likewise.
+void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run);
 
 // Where assets/ lives: $MIMIC2D_ASSETS, else the source tree's assets/.
 std::string AssetPath(const std::string& relative);

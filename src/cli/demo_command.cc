@@ -55,11 +55,11 @@ std::string RunWalkPolicy(const DemoArgs& args) {
   EvalOptions eval;  // 4 ten-second episodes per view
   std::cout << "policy " << args.walk_policy << ", " << eval.episodes_per_view
             << " episodes of " << eval.episode_s << " s per view:\n";
-  std::vector<EvalRow> rows =
+  CheckpointEvaluation evaluation =
       EvaluateCheckpoint(args.walk_policy, {bundle_path}, eval);
-  PrintEvalTable(rows);
+  PrintEvalTable(evaluation);
   WriteEvalJson(args.output_dir + "/walk_eval.json", args.walk_policy, eval,
-                rows);
+                evaluation);
 
   BundleReplayOptions replay;
   replay.character_config = AssetPath("characters/humanoid.yaml");

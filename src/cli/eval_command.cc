@@ -14,14 +14,20 @@ struct EvalArgs {
   std::vector<std::string> bundles;
   std::string output;
   EvalOptions options;
+  std::string starts;   // "": the checkpoint's config
+  std::string cameras;  // "": the checkpoint's config
 };
 
 int RunEval(const EvalArgs& args) {
-  std::vector<EvalRow> rows =
-      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options);
-  PrintEvalTable(rows);
+  SourceOverrides sources;
+  if (!args.starts.empty())
+    sources.initial_states = ParseInitialStateSource(args.starts);
+  if (!args.cameras.empty()) sources.cameras = ParseCameraSource(args.cameras);
+  CheckpointEvaluation evaluation =
+      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options, sources);
+  PrintEvalTable(evaluation);
   if (!args.output.empty()) {
-    WriteEvalJson(args.output, args.checkpoint, args.options, rows);
+    WriteEvalJson(args.output, args.checkpoint, args.options, evaluation);
     std::printf("wrote %s\n", args.output.c_str());
   }
   return 0;
@@ -48,6 +54,14 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
           "--success-px", args->options.success_threshold_px,
           "A frame whose worst keypoint is off by more fails the rollout (px)")
       ->capture_default_str();
+  eval->add_option("--starts", args->starts,
+                   "Initial states from: truth, estimate (mimic2d fit) or "
+                   "default (default: the checkpoint's config)")
+      ->check(CLI::IsMember({"truth", "estimate", "default"}));
+  eval->add_option("--cameras", args->cameras,
+                   "Cameras from: truth or estimate (default: the "
+                   "checkpoint's config)")
+      ->check(CLI::IsMember({"truth", "estimate"}));
   eval->add_option("-o,--output", args->output, "Write the table as JSON here");
   eval->callback([run, args] { *run = [args] { return RunEval(*args); }; });
 }

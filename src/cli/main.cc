@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   m2d::cli::AddReportCommand(app, &run);
   m2d::cli::AddTrainCommand(app, &run);
   m2d::cli::AddEvalCommand(app, &run);
+  m2d::cli::AddFitCommand(app, &run);
   m2d::cli::AddBenchCommand(app, &run);
   try {
     app.parse(argc, argv);

@@ -98,16 +98,49 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
 
 void PrintBundleSummary(const ReferenceBundle& bundle,
                         const std::string& path) {
-  std::printf("%s: bundle '%s', %zu views, %d frames at %.1f fps (%.2f s)%s\n",
+  std::printf("%s: bundle '%s', %zu views, %d frames at %.1f fps (%.2f s)\n",
               path.c_str(), bundle.name.c_str(), bundle.views.size(),
-              bundle.num_frames(), bundle.fps, bundle.num_frames() / bundle.fps,
-              bundle.ground_truth ? ", 3D ground truth" : "");
-  std::printf("  %-8s %8s %10s %10s %12s\n", "view", "frames", "present%",
-              "in-image%", "height(px)");
-  for (const ViewSummary& view : SummarizeBundle(bundle)) {
-    std::printf("  %-8s %8d %10.1f %10.1f %12.1f\n", view.name.c_str(),
+              bundle.num_frames(), bundle.fps,
+              bundle.num_frames() / bundle.fps);
+  size_t views_with_cameras = 0;
+  for (const ReferenceView& view : bundle.views)
+    views_with_cameras += !view.cameras.empty();
+  std::string truth = "none";
+  if (bundle.ground_truth) {
+    truth = bundle.ground_truth->poses.empty()
+                ? "3D keypoints"
+                : "3D keypoints and " + bundle.ground_truth->skeleton_name +
+                      " poses";
+  }
+  std::printf("  ground truth: %s\n", truth.c_str());
+  std::printf("  true cameras: %s\n",
+              views_with_cameras == bundle.views.size() ? "every view"
+              : views_with_cameras == 0
+                  ? "none (use cameras: estimate)"
+                  : (std::to_string(views_with_cameras) + " of " +
+                     std::to_string(bundle.views.size()) + " views")
+                        .c_str());
+  std::printf("  estimate: %s\n",
+              bundle.estimate
+                  ? ("every view (" + bundle.estimate->front().skeleton_name +
+                     " poses, from mimic2d fit)")
+                        .c_str()
+                  : "none");
+  std::printf("  %-8s %8s %10s %10s %12s %10s\n", "view", "frames", "present%",
+              "in-image%", "height(px)", "fit(px)");
+  const std::vector<ViewSummary> summaries = SummarizeBundle(bundle);
+  for (size_t k = 0; k < summaries.size(); ++k) {
+    const ViewSummary& view = summaries[k];
+    std::string fit = "-";
+    if (bundle.estimate) {
+      char text[32];
+      std::snprintf(text, sizeof(text), "%.2f",
+                    (*bundle.estimate)[k].summary.mean_reprojection_px);
+      fit = text;
+    }
+    std::printf("  %-8s %8d %10.1f %10.1f %12.1f %10s\n", view.name.c_str(),
                 view.num_frames, 100 * view.present_fraction,
-                100 * view.in_image_fraction, view.mean_height_px);
+                100 * view.in_image_fraction, view.mean_height_px, fit.c_str());
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
+#include "env/task.h"
 #include "motion/bundle.h"
 #include "render/policy_rollout.h"
 #include "rl/torch_policy.h"
@@ -15,8 +16,7 @@ namespace {
 
 // Checkpoints keep the training's paths, relative to where it ran (the
 // repository root); from elsewhere, find the character there.
-std::shared_ptr<const Character> LoadTrainedCharacter(
-    const TrainConfig& config) {
+std::string TrainedCharacterPath(const TrainConfig& config) {
   std::string path = config.data.character_config;
   if (!std::filesystem::exists(path) &&
       std::filesystem::path(path).is_relative()) {
@@ -24,8 +24,30 @@ std::shared_ptr<const Character> LoadTrainedCharacter(
         std::string(MIMIC2D_SOURCE_DIR) + "/" + path;
     if (std::filesystem::exists(in_repository)) path = in_repository;
   }
-  return LoadCharacterForSimulation(path, config.data.scene,
-                                    config.env.simulation);
+  return path;
+}
+
+// The task a trained policy runs in: its config's simulation, the sources
+// (overridden where asked), noise-free initial states (sigma 0, default
+// buffers), whatever the run trained with.
+TrackingTaskOptions PolicyTaskOptions(const TrainConfig& config,
+                                      const SourceOverrides& overrides) {
+  TrackingTaskOptions options;
+  options.simulation = config.env.simulation;
+  options.sources = config.data.sources();
+  if (overrides.initial_states)
+    options.sources.initial_states = *overrides.initial_states;
+  if (overrides.cameras) options.sources.cameras = *overrides.cameras;
+  try {
+    options.sources.Validate();
+  } catch (const ConfigError& e) {
+    throw ConfigError(std::string(e.what()) +
+                      " (the checkpoint's config has initial_states: " +
+                      SourceName(config.data.initial_states) +
+                      ", cameras: " + SourceName(config.data.cameras) +
+                      "; pass --starts and --cameras together)");
+  }
+  return options;
 }
 
 std::string Cell(double value, const char* format) {
@@ -37,11 +59,12 @@ std::string Cell(double value, const char* format) {
 
 void PrintRow(const EvalRow& row) {
   std::printf(
-      "%-22s %-7s %5d %7.0f %7s %8s %8s %9s %11s %7s\n", row.bundle.c_str(),
+      "%-22s %-7s %5d %7.0f %7s %8s %8s %9s %11s %9s %7s\n", row.bundle.c_str(),
       row.view.c_str(), row.episodes, row.mean_frames,
       Cell(100 * row.succ, "%.1f").c_str(), Cell(row.e2d_px, "%.1f").c_str(),
       Cell(row.eo2d_px, "%.1f").c_str(), Cell(row.e3d_mm, "%.0f").c_str(),
-      Cell(row.e3d_root_mm, "%.0f").c_str(), Cell(row.jitter, "%.2f").c_str());
+      Cell(row.e3d_root_mm, "%.0f").c_str(),
+      Cell(row.e3d_pa_mm, "%.0f").c_str(), Cell(row.jitter, "%.2f").c_str());
 }
 
 nlohmann::json RowToJson(const EvalRow& row) {
@@ -56,6 +79,7 @@ nlohmann::json RowToJson(const EvalRow& row) {
                          {"eo2d_px", optional(row.eo2d_px)},
                          {"e3d_mm", optional(row.e3d_mm)},
                          {"e3d_root_mm", optional(row.e3d_root_mm)},
+                         {"e3d_pa_mm", optional(row.e3d_pa_mm)},
                          {"jitter", row.jitter},
                          {"mean_frames", row.mean_frames}};
   if (!row.rollouts.empty()) {
@@ -72,41 +96,56 @@ nlohmann::json RowToJson(const EvalRow& row) {
 
 }  // namespace
 
-std::vector<EvalRow> EvaluateCheckpoint(
+CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,
-    const EvalOptions& options) {
+    const EvalOptions& options, const SourceOverrides& sources) {
   TorchPolicy policy(checkpoint);
   const TrainConfig& config = policy.config();
   std::vector<std::string> paths =
       bundle_paths.empty() ? config.data.bundles : bundle_paths;
-  auto character = LoadTrainedCharacter(config);
-  std::vector<ReferenceBundle> bundles;
-  for (const std::string& path : paths) bundles.push_back(ReadBundle(path));
-  auto reference = TrackingReference::Prepare(std::move(bundles), *character,
-                                              config.env.simulation.control_hz);
-  // Noise-free initial states (sigma 0), whatever the run trained with.
-  auto states = std::make_shared<InitialStates>(
-      *reference, character, config.env.simulation, StateBufferOptions());
-  return EvaluatePolicy(policy, character, reference, states, config.env,
-                        options);
+  CheckpointEvaluation evaluation;
+  const TrackingTaskOptions task_options = PolicyTaskOptions(config, sources);
+  evaluation.sources = task_options.sources;
+  TrackingTask task = BuildTrackingTask(TrainedCharacterPath(config),
+                                        config.data.scene, paths, task_options);
+  // Measurement only: the truth, read again from the files, goes to the
+  // evaluator and never into the task the policy runs in.
+  std::vector<std::optional<GroundTruth3D>> truth;
+  for (const std::string& path : paths)
+    truth.push_back(ReadBundle(path).ground_truth);
+  evaluation.rows =
+      EvaluatePolicy(policy, task.character, task.reference,
+                     task.initial_states, config.env, options, truth);
+  return evaluation;
 }
 
-void PrintEvalTable(const std::vector<EvalRow>& rows) {
-  std::printf("%-22s %-7s %5s %7s %7s %8s %8s %9s %11s %7s\n", "clip", "view",
-              "eps", "frames", "Succ%", "E2D(px)", "EO2D(px)", "E3D(mm)",
-              "E3Droot(mm)", "Jitter");
-  for (const EvalRow& row : rows) PrintRow(row);
-  PrintRow(AggregateRows(rows));
+void PrintEvalTable(const CheckpointEvaluation& evaluation) {
+  std::printf("%s\n", DescribeSources(evaluation.sources).c_str());
+  if (evaluation.sources.cameras == CameraSource::kEstimate) {
+    std::printf(
+        "E3D against the hidden truth: global not measured (each view's "
+        "estimated world differs from the truth's), E3Droot after the best "
+        "rotation about z, E3DPA after a similarity per frame\n");
+  }
+  std::printf("%-22s %-7s %5s %7s %7s %8s %8s %9s %11s %9s %7s\n", "clip",
+              "view", "eps", "frames", "Succ%", "E2D(px)", "EO2D(px)",
+              "E3D(mm)", "E3Droot(mm)", "E3DPA(mm)", "Jitter");
+  for (const EvalRow& row : evaluation.rows) PrintRow(row);
+  PrintRow(AggregateRows(evaluation.rows));
 }
 
 void WriteEvalJson(const std::string& path, const std::string& checkpoint,
                    const EvalOptions& options,
-                   const std::vector<EvalRow>& rows) {
-  nlohmann::json json = {{"checkpoint", checkpoint},
-                         {"episode_s", options.episode_s},
-                         {"success_threshold_px", options.success_threshold_px},
-                         {"rows", nlohmann::json::array()},
-                         {"all", RowToJson(AggregateRows(rows))}};
+                   const CheckpointEvaluation& evaluation) {
+  const std::vector<EvalRow>& rows = evaluation.rows;
+  nlohmann::json json = {
+      {"checkpoint", checkpoint},
+      {"starts", SourceName(evaluation.sources.initial_states)},
+      {"cameras", SourceName(evaluation.sources.cameras)},
+      {"episode_s", options.episode_s},
+      {"success_threshold_px", options.success_threshold_px},
+      {"rows", nlohmann::json::array()},
+      {"all", RowToJson(AggregateRows(rows))}};
   for (const EvalRow& row : rows) json["rows"].push_back(RowToJson(row));
   WriteJsonFileAtomic(path, json, 2);
 }
@@ -114,15 +153,16 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
 EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
                                        const ReferenceBundle& bundle,
                                        const BundleReplayOptions& replay,
-                                       int start_frame, double episode_s) {
+                                       int start_frame, double episode_s,
+                                       const SourceOverrides& sources) {
   TorchPolicy policy(checkpoint);
   const TrainConfig& config = policy.config();
-  auto character = LoadTrainedCharacter(config);
-  auto reference = TrackingReference::Prepare({bundle}, *character,
-                                              config.env.simulation.control_hz);
-  // Noise-free initial states (sigma 0), whatever the run trained with.
-  auto states = std::make_shared<InitialStates>(
-      *reference, character, config.env.simulation, StateBufferOptions());
+  TrackingTask task = BuildTrackingTask(
+      LoadCharacterForSimulation(TrainedCharacterPath(config),
+                                 config.data.scene, config.env.simulation),
+      {bundle}, PolicyTaskOptions(config, sources));
+  const std::shared_ptr<const Character>& character = task.character;
+  const TrackingReference& reference = *task.reference;
   int view_index = 0;
   for (size_t v = 0; v < bundle.views.size(); ++v) {
     if (bundle.views[v].name == replay.view) view_index = static_cast<int>(v);
@@ -133,9 +173,10 @@ EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
   }
   TrackingEnvOptions env_options = config.env;
   env_options.max_episode_s = episode_s;
-  TrackingEnv env(character, reference, states, env_options, 0);
-  RecordedFrames frames(RecordPolicyRollout(policy, env, *reference, *states,
-                                            view_index, start_frame));
+  TrackingEnv env(character, task.reference, task.initial_states, env_options,
+                  0);
+  RecordedFrames frames(RecordPolicyRollout(
+      policy, env, reference, *task.initial_states, view_index, start_frame));
   const Clip2D& clip = bundle.views[view_index].clip;
   EpisodeRenderOptions render = replay.render;
   render.pose_label = "character (policy)";

@@ -4,36 +4,53 @@
 #ifndef MIMIC2D_CLI_POLICY_RUNS_H_
 #define MIMIC2D_CLI_POLICY_RUNS_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "env/sources.h"
 #include "eval/evaluator.h"
 #include "motion/bundle.h"
 #include "render/episode_renderer.h"
 
 namespace m2d::cli {
 
+// Where a policy run's starts and cameras come from: each unset field
+// keeps the checkpoint's training config.
+struct SourceOverrides {
+  std::optional<InitialStateSource> initial_states;  // eval --starts
+  std::optional<CameraSource> cameras;               // eval --cameras
+};
+
+struct CheckpointEvaluation {
+  TaskSources sources;  // the ones the rollouts used
+  std::vector<EvalRow> rows;
+};
+
 // Rolls the checkpoint's policy out on every view of `bundle_paths` (empty:
 // the bundles of its training config), with its training character and
-// environment settings.
-std::vector<EvalRow> EvaluateCheckpoint(
+// environment settings and noise-free initial states. E3D is measured
+// against the truth read from the bundle files apart from the task.
+CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,
-    const EvalOptions& options);
+    const EvalOptions& options, const SourceOverrides& sources = {});
 
-// One line per row, then the episode-weighted "all" row.
-void PrintEvalTable(const std::vector<EvalRow>& rows);
+// A header naming the sources, one line per row, then the episode-weighted
+// "all" row.
+void PrintEvalTable(const CheckpointEvaluation& evaluation);
 
-// Writes rows + "all" as JSON, atomically.
+// Writes the sources, rows + "all" as JSON, atomically.
 void WriteEvalJson(const std::string& path, const std::string& checkpoint,
                    const EvalOptions& options,
-                   const std::vector<EvalRow>& rows);
+                   const CheckpointEvaluation& evaluation);
 
 // Rolls the checkpoint's policy out on `replay.view` of `bundle` from
 // `start_frame` for at most `episode_s`, and draws it as `replay` says.
 EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
                                        const ReferenceBundle& bundle,
                                        const BundleReplayOptions& replay,
-                                       int start_frame, double episode_s);
+                                       int start_frame, double episode_s,
+                                       const SourceOverrides& sources = {});
 
 }  // namespace m2d::cli
 

@@ -22,16 +22,22 @@ struct RenderArgs {
   std::string policy;       // checkpoint; empty: kinematic replay
   int start_frame = 0;      // policy rollouts start here
   double episode_s = 10.0;  // and last at most this long
+  std::string starts;       // policy rollouts: "" = the checkpoint's config
+  std::string cameras;      // likewise
 };
 
 int RunRender(RenderArgs& args) {
   args.replay.render.shadows = !args.no_shadows;
   const ReferenceBundle bundle = ReadBundle(args.bundle);
+  SourceOverrides sources;
+  if (!args.starts.empty())
+    sources.initial_states = ParseInitialStateSource(args.starts);
+  if (!args.cameras.empty()) sources.cameras = ParseCameraSource(args.cameras);
   const EpisodeSummary summary =
       args.policy.empty()
           ? RenderBundleReplay(bundle, args.replay)
           : RenderCheckpointRollout(args.policy, bundle, args.replay,
-                                    args.start_frame, args.episode_s);
+                                    args.start_frame, args.episode_s, sources);
   std::cout << "rendered " << summary.frames_rendered << " frames, "
             << summary.width_px << "x" << summary.height_px << " px";
   if (std::isfinite(summary.mean_e2d_px)) {
@@ -119,6 +125,16 @@ void AddRenderCommand(CLI::App& app, CommandRun* run) {
       ->add_option("--episode-s", args->episode_s,
                    "Policy rollout: longest episode (s)")
       ->capture_default_str();
+  render
+      ->add_option("--starts", args->starts,
+                   "Policy rollout: initial states from truth, estimate or "
+                   "default (default: the checkpoint's config)")
+      ->check(CLI::IsMember({"truth", "estimate", "default"}));
+  render
+      ->add_option("--cameras", args->cameras,
+                   "Policy rollout: cameras from truth or estimate (default: "
+                   "the checkpoint's config)")
+      ->check(CLI::IsMember({"truth", "estimate"}));
   render->add_flag("--no-shadows", args->no_shadows,
                    "Skip shadows (faster software rendering)");
   render->callback([run, args] { *run = [args] { return RunRender(*args); }; });

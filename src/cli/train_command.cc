@@ -41,6 +41,7 @@ int RunTrain(const TrainArgs& args) {
       args.config_path.c_str(), config.run.run_dir.c_str(), config.ppo.num_envs,
       config.ppo.steps_per_env,
       static_cast<long long>(config.run.total_samples));
+  std::printf("%s\n", DescribeSources(config.data.sources()).c_str());
   std::printf("BLAS: %s\n", DescribeBlas().c_str());
   Trainer trainer(config, args.resume);
 

@@ -86,13 +86,100 @@ void AddJointNoise(double sigma_rad, std::mt19937_64& rng,
   simulation.Refresh();
 }
 
+// Keeps of `bundle` only what `sources` allow downstream (see Prepare);
+// InputError naming the bundle when a source is missing.
+void SanitizeBundle(const Character& character, const TaskSources& sources,
+                    ReferenceBundle* bundle) {
+  const std::string& skeleton = character.skeleton().name;
+  const bool wants_estimate =
+      sources.initial_states == InitialStateSource::kEstimate ||
+      sources.cameras == CameraSource::kEstimate;
+  if (wants_estimate && !bundle->estimate) {
+    throw InputError(bundle->name,
+                     std::string("initial_states: ") +
+                         SourceName(sources.initial_states) +
+                         ", cameras: " + SourceName(sources.cameras) +
+                         " need an estimate and the bundle has none: run "
+                         "mimic2d fit on it");
+  }
+  if (sources.initial_states == InitialStateSource::kTruth) {
+    const GroundTruth3D* truth =
+        bundle->ground_truth ? &*bundle->ground_truth : nullptr;
+    if (truth == nullptr || truth->poses.empty()) {
+      throw InputError(bundle->name,
+                       "initial_states: truth needs ground-truth poses and "
+                       "the bundle has none (use initial_states: estimate "
+                       "after mimic2d fit, or default)");
+    }
+    if (truth->skeleton_name != skeleton) {
+      throw InputError(bundle->name, "ground-truth poses are of skeleton '" +
+                                         truth->skeleton_name +
+                                         "', the character's is '" + skeleton +
+                                         "': initial_states: truth cannot "
+                                         "replay them");
+    }
+  } else {
+    bundle->ground_truth.reset();
+  }
+  if (sources.cameras == CameraSource::kTruth) {
+    for (const ReferenceView& view : bundle->views) {
+      if (view.cameras.empty()) {
+        throw InputError(bundle->name,
+                         "view " + view.name +
+                             " has no true cameras (stripped? use cameras: "
+                             "estimate)");
+      }
+    }
+  } else {
+    for (size_t v = 0; v < bundle->views.size(); ++v)
+      bundle->views[v].cameras = (*bundle->estimate)[v].cameras;
+  }
+  if (sources.initial_states == InitialStateSource::kEstimate) {
+    for (size_t v = 0; v < bundle->views.size(); ++v) {
+      const ViewEstimate& estimate = (*bundle->estimate)[v];
+      if (estimate.skeleton_name != skeleton) {
+        throw InputError(bundle->name,
+                         "the estimate of view " + bundle->views[v].name +
+                             " is of skeleton '" + estimate.skeleton_name +
+                             "', the character's is '" + skeleton +
+                             "': fit it again for this character");
+      }
+    }
+  } else {
+    bundle->estimate.reset();
+  }
+}
+
+// Central differences (one-sided at the ends) of `poses` around frame `t`:
+// second-order accurate, and a one-frame glitch in the recording (the
+// DeepMimic walk's mirrored half-cycles meet with a 0.5 rad shoulder jump)
+// gives half the spurious velocity of a forward difference.
+void QvelAtFrame(const Character& character, const std::vector<Pose3D>& poses,
+                 int t, double dt_s, std::vector<double>* qvel) {
+  const int previous = std::max(t - 1, 0);
+  const int next = std::min(t + 1, static_cast<int>(poses.size()) - 1);
+  std::fill(qvel->begin(), qvel->end(), 0.0);
+  if (next > previous) {
+    QvelFromPoses(character, poses[previous], poses[next],
+                  (next - previous) * dt_s, qvel->data());
+  }
+}
+
 }  // namespace
 
 std::shared_ptr<const TrackingReference> TrackingReference::Prepare(
     std::vector<ReferenceBundle> bundles, const Character& character,
-    double control_hz) {
+    double control_hz, const TaskSources& sources) {
   auto reference = std::shared_ptr<TrackingReference>(new TrackingReference());
   if (bundles.empty()) throw InputError("", "no reference bundles to track");
+  try {
+    sources.Validate();
+  } catch (const ConfigError& e) {
+    throw InputError("sources", e.what());
+  }
+  reference->sources_ = sources;
+  for (ReferenceBundle& bundle : bundles)
+    SanitizeBundle(character, sources, &bundle);
   const KeypointLayout& layout = character.keypoint_layout();
   const std::vector<FreeObject>& objects = character.free_objects();
 
@@ -174,9 +261,10 @@ InitialStates::InitialStates(const TrackingReference& reference,
                              const SimulationOptions& simulation_options,
                              const StateBufferOptions& options,
                              double joint_noise_rad, uint64_t noise_seed) {
-  // Outline: per bundle, per frame, put the character in a plausible pose
-  // (3D truth when known, else a placed default pose), perturb its joints
-  // if asked, and keep the state.
+  // Outline: per buffer (a bundle's, or with an estimate a view's), per
+  // frame, put the character in a plausible pose (3D truth, the view's
+  // estimate, or a placed default pose), perturb its joints if asked, and
+  // keep the state.
   if (!(joint_noise_rad >= 0)) {
     throw ConfigError("initial-state joint noise must be >= 0 rad");
   }
@@ -188,41 +276,52 @@ InitialStates::InitialStates(const TrackingReference& reference,
   std::vector<Eigen::Vector3d> standing_keypoints =
       SimulatedKeypoints(simulation);
   std::vector<double> qvel(character->model()->nv, 0.0);
+  const InitialStateSource source = reference.sources().initial_states;
+  const std::vector<TrackedView>& views = reference.views();
 
-  for (const ReferenceBundle& bundle : reference.bundles()) {
+  // Which views share a buffer: all of a bundle's, or each its own.
+  std::vector<int> first_view_of_buffer;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const bool new_buffer = source == InitialStateSource::kEstimate || v == 0 ||
+                            views[v].bundle != views[v - 1].bundle;
+    if (new_buffer) first_view_of_buffer.push_back(static_cast<int>(v));
+    buffer_of_view_.push_back(static_cast<int>(first_view_of_buffer.size()) -
+                              1);
+  }
+
+  for (int first : first_view_of_buffer) {
+    const TrackedView& view = views[first];
+    const ReferenceBundle& bundle = reference.bundles()[view.bundle];
     StateBuffer buffer(bundle.num_frames(), options);
-    const bool has_poses =
-        bundle.ground_truth && !bundle.ground_truth->poses.empty() &&
-        bundle.ground_truth->skeleton_name == character->skeleton().name;
-    // The default-pose fallback places the character from the first view.
-    const TrackedView* first_view = nullptr;
-    for (const TrackedView& view : reference.views()) {
-      if (&reference.bundles()[view.bundle] == &bundle) {
-        first_view = &view;
-        break;
-      }
-    }
     for (int t = 0; t < bundle.num_frames(); ++t) {
       simulation.Reset();
-      if (has_poses) {
-        const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
-        // Central differences (one-sided at the ends): second-order
-        // accurate, and a one-frame glitch in the recording (the DeepMimic
-        // walk's mirrored half-cycles meet with a 0.5 rad shoulder jump)
-        // gives half the spurious velocity of a forward difference.
-        const int previous = std::max(t - 1, 0);
-        const int next = std::min(t + 1, bundle.num_frames() - 1);
-        std::fill(qvel.begin(), qvel.end(), 0.0);
-        if (next > previous) {
-          QvelFromPoses(*character, poses[previous], poses[next],
-                        (next - previous) * dt_s, qvel.data());
+      switch (source) {
+        case InitialStateSource::kTruth: {
+          const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
+          QvelAtFrame(*character, poses, t, dt_s, &qvel);
+          simulation.SetPose(poses[t], qvel.data());
+          break;
         }
-        simulation.SetPose(poses[t], qvel.data());
-      } else {
-        simulation.SetPose(
-            PlaceDefaultPose(*character, standing, standing_keypoints,
-                             bundle.views[first_view->view].CameraAt(t),
-                             first_view->normalization[t]));
+        case InitialStateSource::kEstimate: {
+          const std::vector<Pose3D>& poses =
+              (*bundle.estimate)[view.view].poses;
+          QvelAtFrame(*character, poses, t, dt_s, &qvel);
+          simulation.SetPose(poses[t], qvel.data());
+          // A fitted pose may graze the floor: lift it out, never down.
+          const double lowest_m = LowestCharacterPointZ(simulation);
+          if (lowest_m < 0) {
+            simulation.mutable_data()
+                ->qpos[character->root_qpos_address() + 2] -= lowest_m;
+            simulation.Refresh();
+          }
+          break;
+        }
+        case InitialStateSource::kDefault:
+          // Placed from the bundle's first view.
+          simulation.SetPose(PlaceDefaultPose(
+              *character, standing, standing_keypoints,
+              bundle.views[view.view].CameraAt(t), view.normalization[t]));
+          break;
       }
       if (joint_noise_rad > 0)
         AddJointNoise(joint_noise_rad, noise_rng, simulation);

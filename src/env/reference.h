@@ -1,6 +1,7 @@
 // env: reference bundles prepared for tracking — per view, the 2D points of
 // every frame laid out for fast lookup and the image normalization of every
-// frame; per bundle, the buffer of initial states.
+// frame; the buffers of initial states (per bundle, or per view when they
+// come from a per-view estimate).
 #ifndef MIMIC2D_ENV_REFERENCE_H_
 #define MIMIC2D_ENV_REFERENCE_H_
 
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "env/observation.h"
+#include "env/sources.h"
 #include "env/state_buffer.h"
 #include "motion/bundle.h"
 #include "sim/simulation.h"
@@ -38,11 +40,18 @@ struct TrackedView {
 class TrackingReference {
  public:
   // Checks that every bundle suits `character` (layout, fps = control rate,
-  // object names matching the scene's free objects) and lays the views out.
+  // object names matching the scene's free objects) and the `sources`, and
+  // lays the views out. Keeps a sanitized copy of each bundle, so nothing
+  // downstream can read what the sources exclude:
+  //  - ground_truth only with initial_states: truth;
+  //  - with cameras: estimate, each view's cameras are its estimate's;
+  //  - the estimate only with initial_states: estimate.
+  // InputError naming the bundle when a source is missing from it.
   static std::shared_ptr<const TrackingReference> Prepare(
       std::vector<ReferenceBundle> bundles, const Character& character,
-      double control_hz);
+      double control_hz, const TaskSources& sources = TaskSources());
 
+  const TaskSources& sources() const { return sources_; }
   const std::vector<ReferenceBundle>& bundles() const { return bundles_; }
   const std::vector<TrackedView>& views() const { return views_; }
   int num_points() const { return num_points_; }
@@ -51,6 +60,7 @@ class TrackingReference {
   const std::vector<int>& object_bodies() const { return object_bodies_; }
 
  private:
+  TaskSources sources_;
   std::vector<ReferenceBundle> bundles_;
   std::vector<TrackedView> views_;
   int num_points_ = 0;
@@ -58,13 +68,19 @@ class TrackingReference {
   std::vector<int> object_bodies_;
 };
 
-// Initial-state buffers, one per bundle (frames are shared by its views:
-// they show the same motion). Mutable by the trainer (ASI), read by envs.
+// Initial-state buffers. From the truth or the default pose, one per bundle
+// (frames are shared by its views: they show the same motion, in one world
+// frame); from an estimate, one per view (each view's poses are in its own
+// world frame). Mutable by the trainer (ASI), read by envs.
 class InitialStates {
  public:
-  // Fills each frame from the bundle's 3D ground-truth poses when present
-  // (velocities by finite differences), otherwise from the model's default
-  // pose placed so that it projects onto the 2D root at the 2D scale.
+  // Fills each frame as the reference's sources say:
+  //  - truth: the bundle's 3D ground-truth poses (velocities by central
+  //    differences);
+  //  - estimate: the view's estimated poses (velocities likewise), lifted
+  //    when the character's lowest point is below the floor;
+  //  - default: the model's default pose placed so that it projects onto
+  //    the 2D root at the 2D scale (from the bundle's first view).
   // With `joint_noise_rad` > 0 ("Noisy S.I."), every actuated hinge angle of
   // every state gets Gaussian noise of that sigma once, here (kept within
   // the hinge's range), and the character is moved vertically so that its
@@ -75,12 +91,22 @@ class InitialStates {
                 const StateBufferOptions& options, double joint_noise_rad = 0.0,
                 uint64_t noise_seed = 0);
 
-  StateBuffer& buffer(int bundle) { return buffers_[bundle]; }
-  const StateBuffer& buffer(int bundle) const { return buffers_[bundle]; }
-  int num_bundles() const { return static_cast<int>(buffers_.size()); }
+  StateBuffer& buffer(int index) { return buffers_[index]; }
+  const StateBuffer& buffer(int index) const { return buffers_[index]; }
+  int num_buffers() const { return static_cast<int>(buffers_.size()); }
+  // The buffer episodes on `view_index` (into TrackingReference::views())
+  // start from.
+  int BufferOf(int view_index) const { return buffer_of_view_[view_index]; }
+  StateBuffer& BufferOfView(int view_index) {
+    return buffers_[BufferOf(view_index)];
+  }
+  const StateBuffer& BufferOfView(int view_index) const {
+    return buffers_[BufferOf(view_index)];
+  }
 
  private:
   std::vector<StateBuffer> buffers_;
+  std::vector<int> buffer_of_view_;
 };
 
 }  // namespace m2d

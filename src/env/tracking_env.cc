@@ -58,7 +58,7 @@ void TrackingEnv::Reset(float* observation) {
       0, static_cast<int>(views.size()) - 1)(rng_);
   const TrackedView& view = views[view_index];
   int frame = std::uniform_int_distribution<int>(0, view.num_frames - 2)(rng_);
-  const StateBuffer& buffer = initial_states_->buffer(view.bundle);
+  const StateBuffer& buffer = initial_states_->BufferOfView(view_index);
   int entry = buffer.Sample(frame, rng_);
   ResetTo(view_index, frame, buffer.entry(frame, entry).state, observation);
 }

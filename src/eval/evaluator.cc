@@ -21,8 +21,17 @@ std::vector<EvalRow> EvaluatePolicy(
     Policy& policy, std::shared_ptr<const Character> character,
     std::shared_ptr<const TrackingReference> reference,
     std::shared_ptr<const InitialStates> initial_states,
-    const TrackingEnvOptions& env_options, const EvalOptions& options) {
+    const TrackingEnvOptions& env_options, const EvalOptions& options,
+    const std::vector<std::optional<GroundTruth3D>>& truth) {
   options.Validate();
+  if (!truth.empty() && truth.size() != reference->bundles().size()) {
+    throw InputError("evaluation",
+                     "3D truth for " + std::to_string(truth.size()) +
+                         " bundles, the reference has " +
+                         std::to_string(reference->bundles().size()));
+  }
+  // Global positions compare only in the true cameras' world.
+  const bool same_world = reference->sources().cameras == CameraSource::kTruth;
   // The evaluation episode: early exit exactly at the success threshold.
   // Episodes start from the given initial states (noise-free ones for
   // evaluation: callers build them with sigma 0).
@@ -50,22 +59,27 @@ std::vector<EvalRow> EvaluatePolicy(
   for (size_t v = 0; v < reference->views().size(); ++v) {
     const TrackedView& view = reference->views()[v];
     const ReferenceBundle& bundle = reference->bundles()[view.bundle];
-    const bool has_truth = bundle.ground_truth.has_value();
+    const GroundTruth3D* bundle_truth =
+        truth.empty() || !truth[view.bundle] ? nullptr : &*truth[view.bundle];
+    const bool has_truth =
+        bundle_truth != nullptr &&
+        bundle_truth->layout == &character->keypoint_layout();
     EvalRow row;
     row.bundle = bundle.name;
     row.view = bundle.views[view.view].name;
-    double succ = 0, e2d = 0, eo2d = 0, e3d = 0, e3d_root = 0, jitter = 0,
-           frames = 0;
+    double succ = 0, e2d = 0, eo2d = 0, e3d = 0, e3d_root = 0, e3d_pa = 0,
+           jitter = 0, frames = 0;
     const int last_start = std::max(0, view.num_frames - 1 - episode_frames);
     for (int e = 0; e < options.episodes_per_view; ++e) {
       int start = options.episodes_per_view == 1
                       ? 0
                       : last_start * e / (options.episodes_per_view - 1);
-      const StateBuffer& buffer = initial_states->buffer(view.bundle);
+      const StateBuffer& buffer =
+          initial_states->BufferOfView(static_cast<int>(v));
       env.ResetTo(static_cast<int>(v), start,
                   buffer.entry(start, buffer.Best(start)).state,
                   observation.data());
-      KeypointFrames simulated, truth;
+      KeypointFrames simulated, true_keypoints;
       double object_error = 0.0;
       int object_frames = 0;
       for (;;) {
@@ -74,7 +88,7 @@ std::vector<EvalRow> EvaluatePolicy(
         if (!outcome.diverged) {
           simulated.push_back(SimulatedKeypoints(env.simulation()));
           if (has_truth)
-            truth.push_back(bundle.ground_truth->keypoints_m[env.frame()]);
+            true_keypoints.push_back(bundle_truth->keypoints_m[env.frame()]);
         }
         if (reference->num_object_points() > 0 && !outcome.diverged) {
           const int num_keypoints = layout.num_keypoints();
@@ -105,9 +119,13 @@ std::vector<EvalRow> EvaluatePolicy(
       jitter += MeanJerk(simulated, eval_env.simulation.control_hz);
       if (object_frames > 0) eo2d += object_error / object_frames;
       if (has_truth) {
-        e3d += 1000.0 * MeanPositionError(simulated, truth);
+        e3d += 1000.0 * MeanPositionError(simulated, true_keypoints);
         e3d_root +=
-            1000.0 * RootRelativePositionError(simulated, truth, layout);
+            1000.0 * (same_world ? RootRelativePositionError(
+                                       simulated, true_keypoints, layout)
+                                 : YawAlignedRootRelativeError(
+                                       simulated, true_keypoints, layout));
+        e3d_pa += 1000.0 * ProcrustesAlignedError(simulated, true_keypoints);
       }
     }
     const double n = options.episodes_per_view;
@@ -118,8 +136,9 @@ std::vector<EvalRow> EvaluatePolicy(
     row.mean_frames = frames / n;
     if (reference->num_object_points() > 0) row.eo2d_px = eo2d / n;
     if (has_truth) {
-      row.e3d_mm = e3d / n;
+      if (same_world) row.e3d_mm = e3d / n;
       row.e3d_root_mm = e3d_root / n;
+      row.e3d_pa_mm = e3d_pa / n;
     }
     rows.push_back(row);
   }
@@ -147,6 +166,7 @@ EvalRow AggregateRows(const std::vector<EvalRow>& rows) {
   all.eo2d_px = average(&EvalRow::eo2d_px);
   all.e3d_mm = average(&EvalRow::e3d_mm);
   all.e3d_root_mm = average(&EvalRow::e3d_root_mm);
+  all.e3d_pa_mm = average(&EvalRow::e3d_pa_mm);
   all.jitter = average(&EvalRow::jitter);
   all.mean_frames = average(&EvalRow::mean_frames);
   return all;

@@ -4,6 +4,7 @@
 #define MIMIC2D_EVAL_EVALUATOR_H_
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,24 +34,33 @@ struct EvalRow {
   std::string bundle;
   std::string view;
   int episodes = 0;
-  double succ = 0.0;          // fraction of successful rollouts
-  double e2d_px = 0.0;        // mean per-frame mean 2D error (until failure)
-  double eo2d_px = -1.0;      // objects' 2D error; -1 without objects
-  double e3d_mm = -1.0;       // global 3D keypoint error; -1 without truth
-  double e3d_root_mm = -1.0;  // root-relative 3D error; -1 without truth
-  double jitter = 0.0;        // 10^3 m/s^3
-  double mean_frames = 0.0;   // frames rolled out per episode
+  double succ = 0.0;      // fraction of successful rollouts
+  double e2d_px = 0.0;    // mean per-frame mean 2D error (until failure)
+  double eo2d_px = -1.0;  // objects' 2D error; -1 without objects
+  // Against the 3D truth (-1 without it). Global error only when the
+  // cameras are the true ones (the worlds agree; else -1); root-relative
+  // after the best rotation about z when they are estimated (an estimate's
+  // heading is arbitrary); Procrustes-aligned (PA-MPJPE) always.
+  double e3d_mm = -1.0;
+  double e3d_root_mm = -1.0;
+  double e3d_pa_mm = -1.0;
+  double jitter = 0.0;                // 10^3 m/s^3
+  double mean_frames = 0.0;           // frames rolled out per episode
   std::vector<EvalRollout> rollouts;  // empty in aggregates
 };
 
 // Episodes start from each frame's best-scoring initial state, use the
 // policy's deterministic action, and end at the first failing frame, the
-// clip end, or episode_s.
+// clip end, or episode_s. `truth` holds, per bundle of the reference, its 3D
+// truth for measurement only (nullopt or empty: no E3D): it is given here,
+// apart from the reference, so that a policy that never saw it can still be
+// measured against it.
 std::vector<EvalRow> EvaluatePolicy(
     Policy& policy, std::shared_ptr<const Character> character,
     std::shared_ptr<const TrackingReference> reference,
     std::shared_ptr<const InitialStates> initial_states,
-    const TrackingEnvOptions& env_options, const EvalOptions& options);
+    const TrackingEnvOptions& env_options, const EvalOptions& options,
+    const std::vector<std::optional<GroundTruth3D>>& truth = {});
 
 // Mean of the rows, weighted by episodes ("all" row).
 EvalRow AggregateRows(const std::vector<EvalRow>& rows);

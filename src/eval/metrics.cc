@@ -1,5 +1,9 @@
 #include "eval/metrics.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
 namespace m2d {
 namespace {
 
@@ -35,6 +39,59 @@ double RootRelativePositionError(const KeypointFrames& simulated,
     for (size_t j = 0; j < simulated[t].size(); ++j, ++count) {
       sum += ((simulated[t][j] - sim_root) - (truth[t][j] - true_root)).norm();
     }
+  }
+  return count ? sum / count : 0.0;
+}
+
+double YawAlignedRootRelativeError(const KeypointFrames& simulated,
+                                   const KeypointFrames& truth,
+                                   const KeypointLayout& layout,
+                                   double* yaw_rad) {
+  // Outline: root-relative points of both; the yaw maximizing
+  // sum b . R(yaw) a over x, y (atan2 of the cross and dot sums); the mean
+  // distance after rotating the simulated points by it.
+  const size_t num_frames = std::min(simulated.size(), truth.size());
+  KeypointFrames relative_sim(num_frames), relative_true(num_frames);
+  double dot = 0.0, cross = 0.0;
+  for (size_t t = 0; t < num_frames; ++t) {
+    const Eigen::Vector3d sim_root = Root(simulated[t], layout);
+    const Eigen::Vector3d true_root = Root(truth[t], layout);
+    for (size_t j = 0; j < simulated[t].size(); ++j) {
+      const Eigen::Vector3d a = simulated[t][j] - sim_root;
+      const Eigen::Vector3d b = truth[t][j] - true_root;
+      dot += a.x() * b.x() + a.y() * b.y();
+      cross += a.x() * b.y() - a.y() * b.x();
+      relative_sim[t].push_back(a);
+      relative_true[t].push_back(b);
+    }
+  }
+  const double yaw = std::atan2(cross, dot);
+  if (yaw_rad != nullptr) *yaw_rad = yaw;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (std::vector<Eigen::Vector3d>& frame : relative_sim) {
+    for (Eigen::Vector3d& point : frame) point = rotation * point;
+  }
+  return MeanPositionError(relative_sim, relative_true);
+}
+
+double ProcrustesAlignedError(const KeypointFrames& simulated,
+                              const KeypointFrames& truth) {
+  double sum = 0.0;
+  long count = 0;
+  for (size_t t = 0; t < simulated.size() && t < truth.size(); ++t) {
+    const long num_points = static_cast<long>(simulated[t].size());
+    Eigen::Matrix3Xd from(3, num_points), to(3, num_points);
+    for (long j = 0; j < num_points; ++j) {
+      from.col(j) = simulated[t][j];
+      to.col(j) = truth[t][j];
+    }
+    const Eigen::Matrix4d transform = Eigen::umeyama(from, to, true);
+    const Eigen::Matrix3Xd aligned =
+        (transform.topLeftCorner<3, 3>() * from).colwise() +
+        transform.topRightCorner<3, 1>();
+    sum += (aligned - to).colwise().norm().sum();
+    count += num_points;
   }
   return count ? sum / count : 0.0;
 }

@@ -22,6 +22,22 @@ double RootRelativePositionError(const KeypointFrames& simulated,
                                  const KeypointFrames& truth,
                                  const KeypointLayout& layout);
 
+// For worlds whose headings differ (a fit's world frame against the
+// truth's): the root-relative error after the single rotation about z that
+// best aligns the simulated root-relative keypoints to the truth's over all
+// frames (closed-form 2D Procrustes on x, y; metres). `yaw_rad`, when given,
+// receives that rotation.
+double YawAlignedRootRelativeError(const KeypointFrames& simulated,
+                                   const KeypointFrames& truth,
+                                   const KeypointLayout& layout,
+                                   double* yaw_rad = nullptr);
+
+// PA-MPJPE: per frame, the similarity transform (rotation, translation,
+// scale; Umeyama) that best maps the simulated keypoints onto the truth's,
+// then the mean distance (metres): pose error alone.
+double ProcrustesAlignedError(const KeypointFrames& simulated,
+                              const KeypointFrames& truth);
+
 // Jitter: mean over frames and keypoints of the magnitude of the third
 // time derivative of positions (finite differences at `fps`), in units of
 // 10^3 m/s^3 as reported in the paper's tables. 0 for fewer than 4 frames.

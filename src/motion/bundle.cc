@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "camera/camera_io.h"
@@ -22,6 +23,47 @@ Eigen::Vector3d Vector3FromJson(const JsonCursor& cursor) {
   return {cursor.At(0).Number(), cursor.At(1).Number(), cursor.At(2).Number()};
 }
 
+// Poses as root_position_m + local_rotations_wxyz (ground truth and
+// estimate share the form).
+nlohmann::json PosesToJson(const std::vector<Pose3D>& poses) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const Pose3D& pose : poses) {
+    nlohmann::json rotations = nlohmann::json::array();
+    for (const Eigen::Quaterniond& q : pose.local_rotations) {
+      rotations.push_back({q.w(), q.x(), q.y(), q.z()});
+    }
+    json.push_back({{"root_position_m", Vector3ToJson(pose.root_position_m)},
+                    {"local_rotations_wxyz", rotations}});
+  }
+  return json;
+}
+
+std::vector<Pose3D> PosesFromJson(const JsonCursor& poses, long num_frames) {
+  std::vector<Pose3D> out;
+  size_t count = poses.ArraySize(num_frames);
+  size_t num_joints = 0;
+  for (size_t t = 0; t < count; ++t) {
+    JsonCursor entry = poses.At(t);
+    Pose3D pose;
+    pose.root_position_m = Vector3FromJson(entry.Field("root_position_m"));
+    JsonCursor rotations = entry.Field("local_rotations_wxyz");
+    size_t joints =
+        rotations.ArraySize(t == 0 ? -1 : static_cast<long>(num_joints));
+    num_joints = joints;
+    for (size_t j = 0; j < joints; ++j) {
+      JsonCursor q = rotations.At(j);
+      q.ArraySize(4);
+      Eigen::Quaterniond rotation(q.At(0).Number(), q.At(1).Number(),
+                                  q.At(2).Number(), q.At(3).Number());
+      if (std::abs(rotation.norm() - 1.0) > 1e-3)
+        q.Fail("not a unit quaternion");
+      pose.local_rotations.push_back(rotation.normalized());
+    }
+    out.push_back(pose);
+  }
+  return out;
+}
+
 nlohmann::json GroundTruthToJson(const GroundTruth3D& truth) {
   nlohmann::json keypoints = nlohmann::json::array();
   for (const auto& frame : truth.keypoints_m) {
@@ -32,17 +74,8 @@ nlohmann::json GroundTruthToJson(const GroundTruth3D& truth) {
   nlohmann::json json = {{"layout", truth.layout->name},
                          {"keypoints_m", keypoints}};
   if (!truth.poses.empty()) {
-    nlohmann::json poses = nlohmann::json::array();
-    for (const Pose3D& pose : truth.poses) {
-      nlohmann::json rotations = nlohmann::json::array();
-      for (const Eigen::Quaterniond& q : pose.local_rotations) {
-        rotations.push_back({q.w(), q.x(), q.y(), q.z()});
-      }
-      poses.push_back({{"root_position_m", Vector3ToJson(pose.root_position_m)},
-                       {"local_rotations_wxyz", rotations}});
-    }
     json["skeleton"] = truth.skeleton_name;
-    json["poses"] = poses;
+    json["poses"] = PosesToJson(truth.poses);
   }
   return json;
 }
@@ -66,30 +99,99 @@ GroundTruth3D GroundTruthFromJson(const JsonCursor& cursor) {
   }
   if (cursor.Has("poses")) {
     truth.skeleton_name = cursor.Field("skeleton").String();
-    JsonCursor poses = cursor.Field("poses");
-    size_t count = poses.ArraySize(static_cast<long>(num_frames));
-    size_t num_joints = 0;
-    for (size_t t = 0; t < count; ++t) {
-      JsonCursor entry = poses.At(t);
-      Pose3D pose;
-      pose.root_position_m = Vector3FromJson(entry.Field("root_position_m"));
-      JsonCursor rotations = entry.Field("local_rotations_wxyz");
-      size_t joints =
-          rotations.ArraySize(t == 0 ? -1 : static_cast<long>(num_joints));
-      num_joints = joints;
-      for (size_t j = 0; j < joints; ++j) {
-        JsonCursor q = rotations.At(j);
-        q.ArraySize(4);
-        Eigen::Quaterniond rotation(q.At(0).Number(), q.At(1).Number(),
-                                    q.At(2).Number(), q.At(3).Number());
-        if (std::abs(rotation.norm() - 1.0) > 1e-3)
-          q.Fail("not a unit quaternion");
-        pose.local_rotations.push_back(rotation.normalized());
-      }
-      truth.poses.push_back(pose);
-    }
+    truth.poses =
+        PosesFromJson(cursor.Field("poses"), static_cast<long>(num_frames));
   }
   return truth;
+}
+
+nlohmann::json SummaryToJson(const FitSummary& summary) {
+  return {{"camera_model", summary.camera_model},
+          {"focal_fixed", summary.focal_fixed},
+          {"initialization", summary.initialization},
+          {"num_frames", summary.num_frames},
+          {"iterations", summary.iterations},
+          {"initial_cost", summary.initial_cost},
+          {"final_cost", summary.final_cost},
+          {"mean_reprojection_px", summary.mean_reprojection_px},
+          {"unconverged_frames", summary.unconverged_frames},
+          {"seconds", summary.seconds}};
+}
+
+FitSummary SummaryFromJson(const JsonCursor& cursor) {
+  FitSummary summary;
+  summary.camera_model = cursor.Field("camera_model").String();
+  summary.focal_fixed = cursor.Field("focal_fixed").Boolean();
+  summary.initialization = cursor.Field("initialization").String();
+  summary.num_frames = static_cast<int>(cursor.Field("num_frames").Integer());
+  summary.iterations = static_cast<int>(cursor.Field("iterations").Integer());
+  summary.initial_cost = cursor.Field("initial_cost").Number();
+  summary.final_cost = cursor.Field("final_cost").Number();
+  summary.mean_reprojection_px = cursor.Field("mean_reprojection_px").Number();
+  JsonCursor frames = cursor.Field("unconverged_frames");
+  const size_t count = frames.ArraySize();
+  for (size_t i = 0; i < count; ++i)
+    summary.unconverged_frames.push_back(
+        static_cast<int>(frames.At(i).Integer()));
+  summary.seconds = cursor.Field("seconds").Number();
+  return summary;
+}
+
+nlohmann::json EstimateToJson(const std::vector<ViewEstimate>& estimate,
+                              const std::vector<ReferenceView>& views) {
+  nlohmann::json entries = nlohmann::json::array();
+  for (size_t k = 0; k < estimate.size(); ++k) {
+    const ViewEstimate& view = estimate[k];
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const PinholeCamera& camera : view.cameras)
+      cameras.push_back(CameraToJson(camera));
+    entries.push_back({{"name", views[k].name},
+                       {"cameras", cameras},
+                       {"skeleton", view.skeleton_name},
+                       {"poses", PosesToJson(view.poses)},
+                       {"residual_px", view.residual_px},
+                       {"summary", SummaryToJson(view.summary)}});
+  }
+  return {{"views", entries}};
+}
+
+// The estimate section; its views must be the bundle's, in order.
+std::vector<ViewEstimate> EstimateFromJson(
+    const JsonCursor& cursor, const std::vector<ReferenceView>& views) {
+  JsonCursor entries = cursor.Field("views");
+  const size_t count = entries.ArraySize(static_cast<long>(views.size()));
+  std::vector<ViewEstimate> estimate;
+  for (size_t k = 0; k < count; ++k) {
+    JsonCursor entry = entries.At(k);
+    const std::string name = entry.Field("name").String();
+    if (name != views[k].name) {
+      entry.Field("name").Fail("estimate of view '" + name + "' where view '" +
+                               views[k].name +
+                               "' was expected (one per view, in order)");
+    }
+    ViewEstimate view;
+    JsonCursor cameras = entry.Field("cameras");
+    const size_t num_cameras = cameras.ArraySize();
+    for (size_t i = 0; i < num_cameras; ++i)
+      view.cameras.push_back(CameraFromJson(cameras.At(i)));
+    view.skeleton_name = entry.Field("skeleton").String();
+    view.poses = PosesFromJson(entry.Field("poses"), -1);
+    JsonCursor residuals = entry.Field("residual_px");
+    const size_t num_residuals = residuals.ArraySize();
+    for (size_t t = 0; t < num_residuals; ++t)
+      view.residual_px.push_back(residuals.At(t).Number());
+    view.summary = SummaryFromJson(entry.Field("summary"));
+    estimate.push_back(std::move(view));
+  }
+  return estimate;
+}
+
+bool PoseIsFinite(const Pose3D& pose) {
+  if (!pose.root_position_m.allFinite()) return false;
+  for (const Eigen::Quaterniond& q : pose.local_rotations) {
+    if (!q.coeffs().allFinite()) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -110,12 +212,65 @@ void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
       throw InputError(source,
                        "view " + view.name + " fps differs from the bundle's");
     }
-    if (view.cameras.size() != 1 &&
+    // No cameras: unknown (stripped, or a user's video).
+    if (!view.cameras.empty() && view.cameras.size() != 1 &&
         static_cast<int>(view.cameras.size()) != num_frames) {
       throw InputError(source, "view " + view.name + " has " +
                                    std::to_string(view.cameras.size()) +
-                                   " cameras: need 1 or one per frame (" +
+                                   " cameras: need none, 1 or one per frame (" +
                                    std::to_string(num_frames) + ")");
+    }
+  }
+  if (bundle.estimate) {
+    const std::vector<ViewEstimate>& estimate = *bundle.estimate;
+    if (estimate.size() != bundle.views.size()) {
+      throw InputError(source, "estimate has " +
+                                   std::to_string(estimate.size()) +
+                                   " views, the bundle has " +
+                                   std::to_string(bundle.views.size()));
+    }
+    for (size_t k = 0; k < estimate.size(); ++k) {
+      const ViewEstimate& view = estimate[k];
+      const std::string where = "estimate of view " + bundle.views[k].name;
+      auto count_error = [&](const std::string& what, size_t count,
+                             const std::string& need) {
+        return InputError(source, where + " has " + std::to_string(count) +
+                                      " " + what + ": need " + need + " (" +
+                                      std::to_string(num_frames) + " frames)");
+      };
+      if (view.cameras.size() != 1 &&
+          static_cast<int>(view.cameras.size()) != num_frames) {
+        throw count_error("cameras", view.cameras.size(), "1 or one per frame");
+      }
+      if (static_cast<int>(view.poses.size()) != num_frames)
+        throw count_error("poses", view.poses.size(), "one per frame");
+      if (static_cast<int>(view.residual_px.size()) != num_frames) {
+        throw count_error("residuals", view.residual_px.size(),
+                          "one per frame");
+      }
+      for (int t = 0; t < num_frames; ++t) {
+        if (!PoseIsFinite(view.poses[t]) ||
+            !std::isfinite(view.residual_px[t])) {
+          throw InputError(source, where + ": frame " + std::to_string(t) +
+                                       " has a non-finite pose or residual");
+        }
+      }
+      for (const PinholeCamera& camera : view.cameras) {
+        const Intrinsics& k = camera.intrinsics();
+        if (!camera.rotation_world_to_camera().allFinite() ||
+            !camera.translation_m().allFinite() || !std::isfinite(k.fx_px) ||
+            !std::isfinite(k.fy_px) || !std::isfinite(k.cx_px) ||
+            !std::isfinite(k.cy_px)) {
+          throw InputError(source, where + ": a camera is not finite");
+        }
+      }
+      const FitSummary& summary = view.summary;
+      if (!std::isfinite(summary.initial_cost) ||
+          !std::isfinite(summary.final_cost) ||
+          !std::isfinite(summary.mean_reprojection_px) ||
+          !std::isfinite(summary.seconds)) {
+        throw InputError(source, where + ": the fit summary is not finite");
+      }
     }
   }
   if (bundle.ground_truth) {
@@ -141,8 +296,12 @@ ReferenceBundle ReadBundle(const std::string& path) {
     root.Field("format").Fail(std::string("expected \"") + kBundleFormat +
                               "\"");
   }
-  if (root.Field("version").Integer() != kBundleVersion) {
-    root.Field("version").Fail("unsupported version");
+  // Version 1 (no estimate, cameras always known) reads as it is.
+  const long version = root.Field("version").Integer();
+  if (version != 1 && version != kBundleVersion) {
+    root.Field("version").Fail("unsupported version " +
+                               std::to_string(version) + " (reads 1 and " +
+                               std::to_string(kBundleVersion) + ")");
   }
   ReferenceBundle bundle;
   bundle.name = root.Field("name").String();
@@ -164,6 +323,8 @@ ReferenceBundle ReadBundle(const std::string& path) {
   if (root.Has("ground_truth")) {
     bundle.ground_truth = GroundTruthFromJson(root.Field("ground_truth"));
   }
+  if (version >= 2 && root.Has("estimate"))
+    bundle.estimate = EstimateFromJson(root.Field("estimate"), bundle.views);
   ValidateBundle(bundle, path);
   return bundle;
 }
@@ -187,7 +348,46 @@ void WriteBundle(const std::string& path, const ReferenceBundle& bundle) {
                          {"views", views}};
   if (bundle.ground_truth)
     json["ground_truth"] = GroundTruthToJson(*bundle.ground_truth);
+  if (bundle.estimate)
+    json["estimate"] = EstimateToJson(*bundle.estimate, bundle.views);
   WriteJsonFileAtomic(path, json);
+}
+
+ReferenceBundle StripBundle(ReferenceBundle bundle) {
+  bundle.ground_truth.reset();
+  bundle.estimate.reset();
+  for (ReferenceView& view : bundle.views) view.cameras.clear();
+  return bundle;
+}
+
+std::string FitSummary::BriefReport() const {
+  // Outline: the model and start, the solve, the fit quality, the frames
+  // that failed (first few).
+  char line[256];
+  std::string report;
+  std::snprintf(
+      line, sizeof(line), "camera %s, focal %s, initialization %s, %d frames\n",
+      camera_model.c_str(), focal_fixed ? "fixed" : "estimated",
+      initialization.empty() ? "-" : initialization.c_str(), num_frames);
+  report += line;
+  std::snprintf(line, sizeof(line),
+                "%d iterations, cost %.6g -> %.6g, mean reprojection %.2f px, "
+                "%.1f s\n",
+                iterations, initial_cost, final_cost, mean_reprojection_px,
+                seconds);
+  report += line;
+  if (converged()) {
+    report += "all frames converged\n";
+  } else {
+    constexpr size_t kListed = 10;
+    report +=
+        std::to_string(unconverged_frames.size()) + " frames did not converge:";
+    for (size_t i = 0; i < unconverged_frames.size() && i < kListed; ++i)
+      report += " " + std::to_string(unconverged_frames[i]);
+    if (unconverged_frames.size() > kListed) report += " ...";
+    report += "\n";
+  }
+  return report;
 }
 
 void DetectorNoiseOptions::Validate() const {

@@ -18,7 +18,9 @@ namespace m2d {
 
 struct ReferenceView {
   std::string name;
-  // One camera (static) or one per clip frame (a camera that moves).
+  // The true cameras: one (static) or one per clip frame (a camera that
+  // moves). Empty when unknown (a user's video, `clip strip`): then only an
+  // estimate (below) can project.
   std::vector<PinholeCamera> cameras;
   Clip2D clip;
 
@@ -37,11 +39,49 @@ struct GroundTruth3D {
   std::vector<Pose3D> poses;
 };
 
+// What a fit (fit/fit.h) reports for one view: a brief account of the
+// solve, kept in the bundle beside the estimate it produced.
+struct FitSummary {
+  std::string camera_model;    // "static" or "moving"
+  bool focal_fixed = false;    // --focal given: focal length not estimated
+  std::string initialization;  // which start won (e.g. "facing 180 deg")
+  int num_frames = 0;
+  int iterations = 0;  // solver iterations over every stage
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double mean_reprojection_px = 0.0;    // confidence-weighted, present points
+  std::vector<int> unconverged_frames;  // frames whose residual stayed high
+  double seconds = 0.0;                 // wall time of the fit
+
+  bool converged() const { return unconverged_frames.empty(); }
+  // A few lines: iterations, cost, reprojection, frames that failed.
+  std::string BriefReport() const;
+};
+
+// One view's fit, from its 2D alone: the camera and the character's pose in
+// the view's own world frame (z up, ground at z = 0; the fit chooses the
+// heading and horizontal origin, so two views' frames differ by a rotation
+// about z and a horizontal shift).
+struct ViewEstimate {
+  std::vector<PinholeCamera> cameras;  // 1 (static) or one per frame
+  std::string skeleton_name;           // the skeleton `poses` belong to
+  std::vector<Pose3D> poses;           // one per frame
+  std::vector<double> residual_px;     // per frame: mean reprojection error
+  FitSummary summary;
+
+  const PinholeCamera& CameraAt(int frame) const {
+    return cameras.size() == 1 ? cameras[0] : cameras[frame];
+  }
+};
+
 struct ReferenceBundle {
   std::string name;
   double fps = 30.0;
   std::vector<ReferenceView> views;
+  // Measurement only (E3D, fit accuracy): never read in 2D-only mode.
   std::optional<GroundTruth3D> ground_truth;
+  // From `mimic2d fit`: one entry per view, in view order.
+  std::optional<std::vector<ViewEstimate>> estimate;
 
   int num_frames() const {
     return views.empty() ? 0 : views.front().clip.num_frames();
@@ -49,13 +89,22 @@ struct ReferenceBundle {
 };
 
 inline constexpr char kBundleFormat[] = "mimic2d.bundle";
-inline constexpr int kBundleVersion = 1;
+// Version 2 adds the `estimate` section and allows views without cameras;
+// version 1 files still load.
+inline constexpr int kBundleVersion = 2;
 
 // Checks that views agree on frame count and fps, that per-frame camera
-// lists match the clip length, and that ground truth has the same length.
+// lists match the clip length (none, 1 or T), that ground truth has the same
+// length, and that an estimate has one entry per view with 1 or T cameras,
+// T poses and T residuals, all finite. Errors name `source` and the view.
 void ValidateBundle(const ReferenceBundle& bundle, const std::string& source);
+// Reads versions 1 and 2; writes version 2 (atomically).
 ReferenceBundle ReadBundle(const std::string& path);
 void WriteBundle(const std::string& path, const ReferenceBundle& bundle);
+
+// What a user with videos has: the 2D clips (image size, fps, names), with
+// the ground truth, the true cameras and any estimate dropped.
+ReferenceBundle StripBundle(ReferenceBundle bundle);
 
 // How a synthetic detector corrupts projected keypoints.
 struct DetectorNoiseOptions {

@@ -276,6 +276,11 @@ BundleReplaySource::BundleReplaySource(
     : bundle_(bundle),
       view_(bundle.views.at(view_index)),
       simulation_(character, simulation) {
+  if (view_.cameras.empty()) {
+    throw InputError(bundle.name, "view " + view_.name +
+                                      " has no true cameras (stripped): "
+                                      "nothing to replay it from");
+  }
   shows_character_ =
       bundle.ground_truth && !bundle.ground_truth->poses.empty() &&
       bundle.ground_truth->skeleton_name == character->skeleton().name;

@@ -23,8 +23,7 @@ EpisodeFrame CurrentFrame(const TrackingEnv& env,
 std::vector<EpisodeFrame> RecordPolicyRollout(
     Policy& policy, TrackingEnv& env, const TrackingReference& reference,
     const InitialStates& initial_states, int view_index, int start_frame) {
-  const StateBuffer& buffer =
-      initial_states.buffer(reference.views()[view_index].bundle);
+  const StateBuffer& buffer = initial_states.BufferOfView(view_index);
   const int best = buffer.Best(start_frame);
   std::vector<float> observation(env.observation_size()),
       action(env.action_size());

@@ -79,7 +79,10 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
 
   if (initial_states != nullptr) {
     const int64_t width = FlatStateSize(state_template);
-    for (int b = 0; b < initial_states->num_bundles(); ++b) {
+    archive.write(
+        "asi_buffers",
+        torch::tensor(static_cast<int64_t>(initial_states->num_buffers())));
+    for (int b = 0; b < initial_states->num_buffers(); ++b) {
       const StateBuffer& buffer = initial_states->buffer(b);
       int64_t entries = 0;
       for (int f = 0; f < buffer.num_frames(); ++f) entries += buffer.size(f);
@@ -191,7 +194,28 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
     }
     if (initial_states != nullptr) {
       const int64_t width = FlatStateSize(state_template);
-      for (int b = 0; b < initial_states->num_bundles(); ++b) {
+      // The buffers must be this task's: one per bundle (truth, default
+      // starts) or one per view (estimate).
+      torch::Tensor saved_buffers;
+      int64_t num_saved = 0;
+      if (archive.try_read("asi_buffers", saved_buffers)) {
+        num_saved = saved_buffers.item<int64_t>();
+      } else {  // older checkpoints: count the buffers present
+        torch::Tensor probe;
+        while (archive.try_read("asi_" + std::to_string(num_saved) + "_states",
+                                probe))
+          ++num_saved;
+      }
+      if (num_saved > 0 && num_saved != initial_states->num_buffers()) {
+        throw InputError(
+            path, "holds " + std::to_string(num_saved) +
+                      " initial-state buffers but this task has " +
+                      std::to_string(initial_states->num_buffers()) +
+                      " (initial_states: estimate keeps one per view, truth "
+                      "and default one per bundle): the config's bundles or "
+                      "initial_states differ from the checkpoint's");
+      }
+      for (int b = 0; b < initial_states->num_buffers(); ++b) {
         std::string prefix = "asi_" + std::to_string(b) + "_";
         torch::Tensor states, scores, frames;
         if (!archive.try_read(prefix + "states", states)) continue;

@@ -11,6 +11,21 @@ void DataOptions::Validate() const {
     throw ConfigError("data.bundles: list at least one bundle");
   if (character_config.empty())
     throw ConfigError("data.character_config is empty");
+  try {
+    sources().Validate();
+  } catch (const ConfigError& e) {
+    throw ConfigError(std::string("data: ") + e.what());
+  }
+}
+
+TrackingTaskOptions TrainingTaskOptions(const TrainConfig& config) {
+  TrackingTaskOptions options;
+  options.simulation = config.env.simulation;
+  options.sources = config.data.sources();
+  options.buffer = config.asi.buffer;
+  options.initial_state_noise_rad = config.env.initial_state_noise_rad;
+  options.noise_seed = config.run.seed + 2'000'003;
+  return options;
 }
 
 void ModelOptions::Validate() const {
@@ -114,6 +129,20 @@ TrainConfig ParseTrainConfig(const YAML::Node& node,
   data.Optional("character_config", &config.data.character_config);
   data.Optional("scene", &config.data.scene);
   data.Optional("bundles", &config.data.bundles);
+  std::string initial_states = SourceName(config.data.initial_states);
+  std::string cameras = SourceName(config.data.cameras);
+  data.Optional("initial_states", &initial_states);
+  data.Optional("cameras", &cameras);
+  try {
+    config.data.initial_states = ParseInitialStateSource(initial_states);
+  } catch (const ConfigError& e) {
+    data.Fail("initial_states", std::string("is not known: ") + e.what());
+  }
+  try {
+    config.data.cameras = ParseCameraSource(cameras);
+  } catch (const ConfigError& e) {
+    data.Fail("cameras", std::string("is not known: ") + e.what());
+  }
   data.RejectUnknownKeys();
 
   YamlSection env = OpenSection(root, node, "env", yaml_path, &files, &source);
@@ -218,6 +247,10 @@ std::string TrainConfigToYaml(const TrainConfig& config) {
   out << YAML::Key << "scene" << YAML::Value << config.data.scene;
   out << YAML::Key << "bundles" << YAML::Value << YAML::Flow
       << config.data.bundles;
+  out << YAML::Key << "initial_states" << YAML::Value
+      << SourceName(config.data.initial_states);
+  out << YAML::Key << "cameras" << YAML::Value
+      << SourceName(config.data.cameras);
   out << YAML::EndMap;
 
   const TrackingEnvOptions& e = config.env;

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "env/sources.h"
+#include "env/task.h"
 #include "env/tracking_env.h"
 
 namespace m2d {
@@ -17,7 +19,13 @@ struct DataOptions {
   std::string character_config = "assets/characters/humanoid.yaml";
   std::string scene = "flat";
   std::vector<std::string> bundles;  // reference bundle files
+  // Where episodes start and which cameras project (env/sources.h): the
+  // bundles' 3D truth and true cameras, or their `mimic2d fit` estimate
+  // (2D only); initial states may also be a default pose.
+  InitialStateSource initial_states = InitialStateSource::kTruth;
+  CameraSource cameras = CameraSource::kTruth;
 
+  TaskSources sources() const { return {initial_states, cameras}; }
   void Validate() const;
 };
 
@@ -97,6 +105,10 @@ struct TrainConfig {
 
   void Validate() const;  // throws ConfigError
 };
+
+// The tracking task the config trains on: its sources, ASI buffer options
+// and Noisy S.I. (seeded from run.seed).
+TrackingTaskOptions TrainingTaskOptions(const TrainConfig& config);
 
 // Reads a training config. Each top-level section (data, env, model,
 // agent, asi, run) is a mapping, or a path to a YAML file holding it

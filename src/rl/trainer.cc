@@ -97,7 +97,7 @@ bool PlausibleWallTime(double seconds) {
 
 // A visited state offered to the ASI buffers.
 struct CapturedState {
-  int bundle = 0;
+  int buffer = 0;  // InitialStates::BufferOf(the episode's view)
   int frame = 0;
   SimState state;
 };
@@ -162,17 +162,15 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
 
   // Outline: character and references -> initial states -> environments ->
   // networks and optimizer -> (resume) checkpoint -> log.
-  s.character = LoadCharacterForSimulation(
-      config.data.character_config, config.data.scene, config.env.simulation);
-  std::vector<ReferenceBundle> bundles;
-  for (const std::string& path : config.data.bundles)
-    bundles.push_back(ReadBundle(path));
-  s.reference = TrackingReference::Prepare(std::move(bundles), *s.character,
-                                           config.env.simulation.control_hz);
   // Noisy S.I. perturbs the buffers once, here; ASI then replaces states.
-  s.initial_states = std::make_shared<InitialStates>(
-      *s.reference, s.character, config.env.simulation, config.asi.buffer,
-      config.env.initial_state_noise_rad, run.seed + 2'000'003);
+  TrackingTask task =
+      BuildTrackingTask(config.data.character_config, config.data.scene,
+                        config.data.bundles, TrainingTaskOptions(config));
+  s.character = task.character;
+  s.reference = task.reference;
+  s.initial_states = task.initial_states;
+  spdlog::info("{} initial-state buffers for {} views",
+               s.initial_states->num_buffers(), s.reference->views().size());
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
@@ -303,8 +301,8 @@ void Trainer::State::Collect(RolloutStorage& storage,
       for (int i = 0; i < num_envs; ++i) {
         if (vec.terminated()[i] || vec.truncated()[i]) continue;
         TrackingEnv& env = vec.env(i);
-        captured.push_back(
-            {env.view().bundle, env.frame(), env.simulation().Save()});
+        captured.push_back({initial_states->BufferOf(env.episode().view_index),
+                            env.frame(), env.simulation().Save()});
         const float* row =
             vec.observations() + static_cast<size_t>(i) * observation_size;
         captured_observations.insert(captured_observations.end(), row,
@@ -334,7 +332,7 @@ void Trainer::State::UpdateStateBuffers() {
         model->Value(Normalized(raw)).to(torch::kDouble).contiguous();
     const double* score = scores.data_ptr<double>();
     for (size_t i = 0; i < captured.size(); ++i) {
-      initial_states->buffer(captured[i].bundle)
+      initial_states->buffer(captured[i].buffer)
           .Insert(captured[i].frame, captured[i].state, score[i]);
     }
   }
@@ -342,10 +340,12 @@ void Trainer::State::UpdateStateBuffers() {
   if (counters.iteration % kRescoreEveryIterations != 0) return;
   std::vector<float> observation(observation_size);
   const std::vector<TrackedView>& views = reference->views();
-  for (int b = 0; b < initial_states->num_bundles(); ++b) {
+  for (int b = 0; b < initial_states->num_buffers(); ++b) {
+    // A state is scored as seen from one of the views its buffer serves.
     std::vector<int> bundle_views;
     for (size_t v = 0; v < views.size(); ++v) {
-      if (views[v].bundle == b) bundle_views.push_back(static_cast<int>(v));
+      if (initial_states->BufferOf(static_cast<int>(v)) == b)
+        bundle_views.push_back(static_cast<int>(v));
     }
     StateBuffer& buffer = initial_states->buffer(b);
     std::vector<float> batch;

@@ -6,7 +6,10 @@
 #include <cstdio>
 #include <fstream>
 
+#include "common/file_io.h"
 #include "motion/bundle.h"
+#include "motion/motion_io.h"
+#include "synthetic_motion.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -90,6 +93,100 @@ void ExpectInputError(const std::string& arguments, const std::string& file,
   EXPECT_NE(result.output.find(problem), std::string::npos) << result.output;
   EXPECT_EQ(result.output.find("terminate called"), std::string::npos)
       << result.output;
+}
+
+// `clip strip` leaves what a user with videos has: the 2D, no truth, no
+// cameras, no estimate; `clip info` says so.
+TEST(Cli, ClipStripKeepsOnlyThe2D) {
+  const std::string dir = testing::TempDir("cli_strip");
+  auto skeleton = std::make_shared<const Skeleton>(
+      LoadSkeleton(testing::SourcePath("assets/skeletons/humanoid.yaml")));
+  KeypointMap map = LoadKeypointMap(
+      testing::SourcePath("assets/skeletons/humanoid.coco17.yaml"), *skeleton);
+  BundleFromMotionOptions options;
+  options.rig.num_views = 3;
+  options.follow = CameraFollow::kRootDolly;
+  ReferenceBundle bundle = MakeBundleFromMotion(
+      testing::GlidingMotion(skeleton, testing::IdentityPose(*skeleton), 1.0),
+      map, options, "gliding");
+  bundle.estimate = testing::EstimateFromTruth(bundle, {{0.3, {1, 1, 0}}});
+  const std::string full = dir + "/full.json";
+  const std::string stripped_path = dir + "/stripped.json";
+  WriteBundle(full, bundle);
+  CommandResult info = RunMimic2d("clip info " + full);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("true cameras: every view"), std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("estimate: every view"), std::string::npos)
+      << info.output;
+
+  CommandResult result =
+      RunMimic2d("clip strip " + full + " -o " + stripped_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  ReferenceBundle stripped = ReadBundle(stripped_path);
+  EXPECT_FALSE(stripped.ground_truth.has_value());
+  EXPECT_FALSE(stripped.estimate.has_value());
+  EXPECT_EQ(stripped.name, "gliding");
+  EXPECT_EQ(stripped.fps, bundle.fps);
+  ASSERT_EQ(stripped.views.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_TRUE(stripped.views[k].cameras.empty());
+    EXPECT_EQ(stripped.views[k].name, bundle.views[k].name);
+    const Clip2D& clip = stripped.views[k].clip;
+    EXPECT_EQ(clip.image_width_px, bundle.views[k].clip.image_width_px);
+    EXPECT_EQ(clip.image_height_px, bundle.views[k].clip.image_height_px);
+    ASSERT_EQ(clip.num_frames(), bundle.num_frames());
+    for (int t = 0; t < clip.num_frames(); ++t) {
+      for (int j = 0; j < 17; ++j) {
+        EXPECT_NEAR((clip.keypoints.at(t, j).Pixel() -
+                     bundle.views[k].clip.keypoints.at(t, j).Pixel())
+                        .norm(),
+                    0.0, 1e-9);
+      }
+    }
+  }
+  info = RunMimic2d("clip info " + stripped_path);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("ground truth: none"), std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("true cameras: none"), std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("estimate: none"), std::string::npos)
+      << info.output;
+  ExpectInputError("clip strip " + dir + "/absent.json -o " + dir + "/x.json",
+                   dir + "/absent.json", "cannot open");
+
+  // Eval of the committed walk policy from the estimate alone, measured
+  // against the truth kept in the original file.
+  const std::string policy =
+      testing::SourcePath("assets/policies/walk/checkpoint.pt");
+  ReferenceBundle fitted = StripBundle(bundle);
+  fitted.estimate = bundle.estimate;
+  const std::string fitted_path = dir + "/fitted.json";
+  WriteBundle(fitted_path, fitted);
+  const std::string json_path = dir + "/eval.json";
+  result = RunMimic2d("eval " + policy + " --bundle " + full +
+                      " --starts estimate --cameras estimate --episodes 1 "
+                      "--episode-s 0.3 -o " +
+                      json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("initial states from the fitted estimate"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("E3DPA(mm)"), std::string::npos)
+      << result.output;
+  nlohmann::json eval = ReadJsonFile(json_path);
+  EXPECT_EQ(eval["starts"], "estimate");
+  EXPECT_EQ(eval["cameras"], "estimate");
+  EXPECT_TRUE(eval["all"]["e3d_mm"].is_null());  // worlds differ
+  EXPECT_TRUE(eval["all"]["e3d_pa_mm"].is_number());
+  // Truth sources on the stripped file: a named error, not a crash.
+  ExpectInputError(
+      "eval " + policy + " --bundle " + fitted_path + " --episodes 1",
+      fitted_path, "initial_states: truth needs ground-truth");
+  ExpectInputError("eval " + policy + " --bundle " + fitted_path +
+                       " --starts default --episodes 1",
+                   fitted_path, "stripped? use cameras: estimate");
 }
 
 TEST(Cli, BadInputIsAClearErrorNotACrash) {

@@ -8,10 +8,13 @@
 
 #include "env/policy.h"
 #include "env/reference.h"
+#include "env/task.h"
 #include "env/tracking_env.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
+#include "sim/pose_mapping.h"
 #include "sim/simulation.h"
+#include "synthetic_motion.h"
 #include "test_paths.h"
 
 namespace m2d::testing {
@@ -42,6 +45,19 @@ inline ReferenceBundle MakeWalkBundle(const std::string& motion_path,
                               "walk");
 }
 
+// Without the shared data: the humanoid's standing pose carried along +x
+// (tests/synthetic_motion.h), seen by `num_views` static cameras.
+inline ReferenceBundle MakeGlidingBundle(const Character& character,
+                                         double duration_s = 2.0,
+                                         int num_views = 2) {
+  const Pose3D standing = QposToPose(character, character.model()->qpos0);
+  BundleFromMotionOptions options;
+  options.rig.num_views = num_views;
+  return MakeBundleFromMotion(
+      GlidingMotion(character.shared_skeleton(), standing, duration_s),
+      character.keypoint_map(), options, "gliding");
+}
+
 // A scripted controller without LibTorch: every PD target at the centre of
 // its range, whatever it observes. It cannot walk.
 class ZeroPolicy : public Policy {
@@ -66,11 +82,12 @@ inline WalkTask MakeWalkTask(const std::string& motion_path,
   task.character = LoadHumanoid(task.options.simulation);
   std::vector<ReferenceBundle> bundles;
   bundles.push_back(MakeWalkBundle(motion_path, *task.character, duration_s));
-  task.reference = TrackingReference::Prepare(
-      std::move(bundles), *task.character, task.options.simulation.control_hz);
-  task.initial_states = std::make_shared<InitialStates>(
-      *task.reference, task.character, task.options.simulation,
-      StateBufferOptions());
+  TrackingTaskOptions task_options;
+  task_options.simulation = task.options.simulation;
+  TrackingTask built =
+      BuildTrackingTask(task.character, std::move(bundles), task_options);
+  task.reference = built.reference;
+  task.initial_states = built.initial_states;
   return task;
 }
 

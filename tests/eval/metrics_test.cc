@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -164,6 +165,84 @@ TEST(MeanJerk, FewerThanFourFramesGiveZero) {
   }
 }
 
+// `frames` mapped by x -> scale * R x + offset, one transform per frame when
+// `per_frame`, else the same for all.
+KeypointFrames Transformed(KeypointFrames frames,
+                           const Eigen::Matrix3d& rotation, double scale,
+                           const Eigen::Vector3d& offset_m,
+                           bool per_frame = false) {
+  for (size_t t = 0; t < frames.size(); ++t) {
+    const Eigen::Matrix3d r =
+        per_frame ? Eigen::Matrix3d(
+                        Eigen::AngleAxisd(0.2 * t, Eigen::Vector3d::UnitX()) *
+                        rotation)
+                  : rotation;
+    const Eigen::Vector3d shift = per_frame ? (1.0 + t) * offset_m : offset_m;
+    for (Eigen::Vector3d& point : frames[t]) point = scale * r * point + shift;
+  }
+  return frames;
+}
+
+Eigen::Matrix3d Yaw(double angle_rad) {
+  return Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitZ())
+      .toRotationMatrix();
+}
+
+TEST(YawAlignedRootRelativeError, AYawedAndShiftedCopyHasNoError) {
+  const KeypointFrames truth = MakePoses(8);
+  // Another world frame: turned by 2.5 rad about z and shifted.
+  const KeypointFrames simulated =
+      Transformed(truth, Yaw(2.5), 1.0, {3.0, -1.0, 0.0});
+  double yaw_rad = 0.0;
+  EXPECT_NEAR(
+      YawAlignedRootRelativeError(simulated, truth, Coco17Layout(), &yaw_rad),
+      0.0, 1e-12);
+  EXPECT_NEAR(yaw_rad, -2.5, 1e-9);  // the turn back
+  // Without the alignment, the turn is an error.
+  EXPECT_GT(RootRelativePositionError(simulated, truth, Coco17Layout()), 0.1);
+  // A tilt is not a yaw: it remains.
+  const KeypointFrames tilted = Transformed(
+      truth, Eigen::Matrix3d(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX())),
+      1.0, Eigen::Vector3d::Zero());
+  EXPECT_GT(YawAlignedRootRelativeError(tilted, truth, Coco17Layout()), 0.05);
+}
+
+TEST(YawAlignedRootRelativeError, AnErrorAfterAlignmentIsMeasured) {
+  const KeypointFrames truth = MakePoses(4);
+  KeypointFrames simulated = Transformed(truth, Yaw(-1.0), 1.0, {1, 2, 0});
+  // Every non-root keypoint 2 cm higher (the roots are hips 11 and 12).
+  for (auto& frame : simulated) {
+    for (int j = 0; j < kNumKeypoints; ++j) {
+      if (j != 11 && j != 12) frame[j].z() += 0.02;
+    }
+  }
+  // Mean over 17 keypoints of |dz - mean of the hips' dz (0)| = 15 * 2 cm.
+  EXPECT_NEAR(YawAlignedRootRelativeError(simulated, truth, Coco17Layout()),
+              15.0 * 0.02 / 17, 1e-9);
+}
+
+TEST(ProcrustesAlignedError, ARotatedScaledShiftedCopyHasNoError) {
+  const KeypointFrames truth = MakePoses(6);
+  // A different similarity per frame, rotations about every axis.
+  const KeypointFrames simulated =
+      Transformed(truth, Yaw(0.8), 1.3, {0.5, -2.0, 0.7}, true);
+  EXPECT_NEAR(ProcrustesAlignedError(simulated, truth), 0.0, 1e-9);
+  EXPECT_GT(MeanPositionError(simulated, truth), 0.1);
+}
+
+TEST(ProcrustesAlignedError, APoseErrorRemains) {
+  const KeypointFrames truth = MakePoses(3);
+  KeypointFrames simulated = truth;
+  for (auto& frame : simulated) frame[9].x() += 0.3;  // a wrist 30 cm off
+  const double error = ProcrustesAlignedError(simulated, truth);
+  EXPECT_GT(error, 0.005);
+  // Whatever similarity moved the simulated points, the same error.
+  EXPECT_NEAR(ProcrustesAlignedError(
+                  Transformed(simulated, Yaw(1.0), 0.7, {1, 2, 3}), truth),
+              error, 1e-9);
+  EXPECT_EQ(ProcrustesAlignedError({}, truth), 0.0);
+}
+
 EvalRow Row(const std::string& view, int episodes, double succ, double e2d_px,
             double e3d_mm) {
   EvalRow row;
@@ -174,6 +253,7 @@ EvalRow Row(const std::string& view, int episodes, double succ, double e2d_px,
   row.e2d_px = e2d_px;
   row.e3d_mm = e3d_mm;
   row.e3d_root_mm = e3d_mm < 0 ? -1.0 : e3d_mm / 2;
+  row.e3d_pa_mm = e3d_mm < 0 ? -1.0 : e3d_mm / 4;
   row.jitter = 0.1 * episodes;
   row.mean_frames = 10.0 * episodes;
   return row;
@@ -190,6 +270,7 @@ TEST(AggregateRows, WeightsEachRowByItsEpisodes) {
   EXPECT_DOUBLE_EQ(all.e2d_px, (2 * 10.0 + 6 * 30.0) / 8);   // 25
   EXPECT_DOUBLE_EQ(all.e3d_mm, (2 * 100.0 + 6 * 60.0) / 8);  // 70
   EXPECT_DOUBLE_EQ(all.e3d_root_mm, 35.0);
+  EXPECT_DOUBLE_EQ(all.e3d_pa_mm, (2 * 25.0 + 6 * 15.0) / 8);
   EXPECT_DOUBLE_EQ(all.jitter, (2 * 0.2 + 6 * 0.6) / 8);         // 0.5
   EXPECT_DOUBLE_EQ(all.mean_frames, (2 * 20.0 + 6 * 60.0) / 8);  // 50
   // Neither row has objects: EO2D stays "not measured".

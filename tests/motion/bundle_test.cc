@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "common/error.h"
+#include "common/file_io.h"
 #include "motion/motion_io.h"
+#include "synthetic_motion.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -147,6 +151,188 @@ TEST(Bundle, InconsistentBundlesAreRejected) {
   bundle.views.pop_back();
   bundle.views[0].cameras.resize(3);
   EXPECT_THROW(ValidateBundle(bundle, "x.json"), InputError);
+}
+
+// Without the shared data: the skeleton's identity pose gliding forward,
+// seen by 2 views, with a synthetic estimate of each view.
+ReferenceBundle GlidingBundleWithEstimate() {
+  auto skeleton = std::make_shared<const Skeleton>(
+      LoadSkeleton(testing::SourcePath("assets/skeletons/humanoid.yaml")));
+  KeypointMap map = LoadKeypointMap(
+      testing::SourcePath("assets/skeletons/humanoid.coco17.yaml"), *skeleton);
+  BundleFromMotionOptions options;
+  options.rig.num_views = 2;
+  ReferenceBundle bundle = MakeBundleFromMotion(
+      testing::GlidingMotion(skeleton, testing::IdentityPose(*skeleton), 1.0),
+      map, options, "gliding");
+  bundle.estimate = testing::EstimateFromTruth(
+      bundle, {{0.4, {1.0, 2.0, 0.0}}, {-1.1, {0.0, -3.0, 0.0}}});
+  (*bundle.estimate)[1].summary.unconverged_frames = {3, 17};
+  return bundle;
+}
+
+TEST(Bundle, Version2RoundTripsTheEstimate) {
+  ReferenceBundle bundle = GlidingBundleWithEstimate();
+  const std::string file = testing::TempDir("bundle_v2") + "/gliding.json";
+  WriteBundle(file, bundle);
+  EXPECT_EQ(ReadJsonFile(file)["version"], 2);
+  ReferenceBundle read = ReadBundle(file);
+  ASSERT_TRUE(read.estimate.has_value());
+  ASSERT_EQ(read.estimate->size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    const ViewEstimate& a = (*bundle.estimate)[k];
+    const ViewEstimate& b = (*read.estimate)[k];
+    ASSERT_EQ(b.cameras.size(), a.cameras.size());
+    EXPECT_TRUE(b.cameras[0].rotation_world_to_camera().isApprox(
+        a.cameras[0].rotation_world_to_camera(), 1e-12));
+    EXPECT_TRUE(b.cameras[0].translation_m().isApprox(
+        a.cameras[0].translation_m(), 1e-12));
+    EXPECT_EQ(b.skeleton_name, a.skeleton_name);
+    ASSERT_EQ(b.poses.size(), a.poses.size());
+    for (size_t t = 0; t < a.poses.size(); ++t) {
+      EXPECT_TRUE(
+          b.poses[t].root_position_m.isApprox(a.poses[t].root_position_m));
+      for (size_t j = 0; j < a.poses[t].local_rotations.size(); ++j) {
+        EXPECT_TRUE(b.poses[t].local_rotations[j].isApprox(
+            a.poses[t].local_rotations[j], 1e-12));
+      }
+    }
+    EXPECT_EQ(b.residual_px, a.residual_px);
+    EXPECT_EQ(b.summary.camera_model, a.summary.camera_model);
+    EXPECT_EQ(b.summary.focal_fixed, a.summary.focal_fixed);
+    EXPECT_EQ(b.summary.initialization, a.summary.initialization);
+    EXPECT_EQ(b.summary.num_frames, a.summary.num_frames);
+    EXPECT_EQ(b.summary.iterations, a.summary.iterations);
+    EXPECT_EQ(b.summary.initial_cost, a.summary.initial_cost);
+    EXPECT_EQ(b.summary.final_cost, a.summary.final_cost);
+    EXPECT_EQ(b.summary.mean_reprojection_px, a.summary.mean_reprojection_px);
+    EXPECT_EQ(b.summary.unconverged_frames, a.summary.unconverged_frames);
+    EXPECT_EQ(b.summary.seconds, a.summary.seconds);
+  }
+  // A file whose estimate names views out of order is rejected.
+  nlohmann::json json = ReadJsonFile(file);
+  std::swap(json["estimate"]["views"][0], json["estimate"]["views"][1]);
+  WriteJsonFileAtomic(file, json);
+  try {
+    ReadBundle(file);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("one per view, in order"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Bundle, Version1FilesStillLoad) {
+  ReferenceBundle bundle = GlidingBundleWithEstimate();
+  bundle.estimate.reset();
+  const std::string file = testing::TempDir("bundle_v1") + "/gliding.json";
+  WriteBundle(file, bundle);
+  nlohmann::json json = ReadJsonFile(file);
+  json["version"] = 1;
+  WriteJsonFileAtomic(file, json);
+  ReferenceBundle read = ReadBundle(file);
+  EXPECT_EQ(read.views.size(), 2u);
+  EXPECT_TRUE(read.ground_truth.has_value());
+  EXPECT_FALSE(read.estimate.has_value());
+  EXPECT_EQ(read.views[0].cameras.size(), 1u);
+  json["version"] = 3;
+  WriteJsonFileAtomic(file, json);
+  EXPECT_THROW(ReadBundle(file), InputError);
+}
+
+TEST(Bundle, StripKeepsOnlyThe2D) {
+  ReferenceBundle bundle = GlidingBundleWithEstimate();
+  ReferenceBundle stripped = StripBundle(bundle);
+  EXPECT_FALSE(stripped.ground_truth.has_value());
+  EXPECT_FALSE(stripped.estimate.has_value());
+  EXPECT_EQ(stripped.name, bundle.name);
+  EXPECT_EQ(stripped.fps, bundle.fps);
+  ASSERT_EQ(stripped.views.size(), bundle.views.size());
+  for (size_t k = 0; k < bundle.views.size(); ++k) {
+    const Clip2D& a = bundle.views[k].clip;
+    const Clip2D& b = stripped.views[k].clip;
+    EXPECT_TRUE(stripped.views[k].cameras.empty());
+    EXPECT_EQ(stripped.views[k].name, bundle.views[k].name);
+    EXPECT_EQ(b.image_width_px, a.image_width_px);
+    EXPECT_EQ(b.image_height_px, a.image_height_px);
+    EXPECT_EQ(b.fps, a.fps);
+    for (int t = 0; t < a.num_frames(); ++t) {
+      for (int j = 0; j < 17; ++j)
+        EXPECT_EQ(b.keypoints.at(t, j).Pixel(), a.keypoints.at(t, j).Pixel());
+    }
+  }
+  // A stripped bundle (views without cameras) is written and read back.
+  const std::string file = testing::TempDir("bundle_strip") + "/s.json";
+  WriteBundle(file, stripped);
+  EXPECT_TRUE(ReadBundle(file).views[1].cameras.empty());
+}
+
+TEST(Bundle, BadEstimatesNameTheFileAndTheView) {
+  const ReferenceBundle good = GlidingBundleWithEstimate();
+  auto expect_error = [](const ReferenceBundle& bundle,
+                         const std::string& needle) {
+    try {
+      ValidateBundle(bundle, "g.json");
+      ADD_FAILURE() << "expected InputError with " << needle;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("g.json"), std::string::npos) << message;
+      EXPECT_NE(message.find(needle), std::string::npos) << message;
+    }
+  };
+  const std::string view1 = "estimate of view " + good.views[1].name;
+  ReferenceBundle bad = good;
+  bad.estimate->pop_back();
+  expect_error(bad, "estimate has 1 views");
+  bad = good;
+  (*bad.estimate)[1].poses.pop_back();
+  expect_error(
+      bad, view1 + " has " + std::to_string(good.num_frames() - 1) + " poses");
+  bad = good;
+  (*bad.estimate)[1].residual_px.push_back(1.0);
+  expect_error(bad, view1 + " has " + std::to_string(good.num_frames() + 1) +
+                        " residuals");
+  bad = good;
+  (*bad.estimate)[1].cameras.resize(2, (*bad.estimate)[1].cameras[0]);
+  expect_error(bad, view1 + " has 2 cameras");
+  bad = good;
+  (*bad.estimate)[1].poses[4].root_position_m.x() = std::nan("");
+  expect_error(bad, view1 + ": frame 4");
+  bad = good;
+  (*bad.estimate)[0].residual_px[2] = INFINITY;
+  expect_error(bad, "frame 2 has a non-finite");
+  EXPECT_NO_THROW(ValidateBundle(good, "g.json"));
+}
+
+TEST(FitSummary, BriefReportListsTheFramesThatFailed) {
+  FitSummary summary;
+  summary.camera_model = "moving";
+  summary.focal_fixed = true;
+  summary.initialization = "facing 180 deg";
+  summary.num_frames = 300;
+  summary.iterations = 42;
+  summary.initial_cost = 1234.5;
+  summary.final_cost = 12.25;
+  summary.mean_reprojection_px = 3.5;
+  summary.seconds = 7.25;
+  std::string report = summary.BriefReport();
+  for (const char* needle :
+       {"camera moving", "focal fixed", "facing 180 deg", "42 iterations",
+        "1234.5", "12.25", "3.50 px", "7.2 s", "all frames converged"}) {
+    EXPECT_NE(report.find(needle), std::string::npos) << needle << "\n"
+                                                      << report;
+  }
+  for (int t = 0; t < 12; ++t) summary.unconverged_frames.push_back(10 + t);
+  summary.focal_fixed = false;
+  report = summary.BriefReport();
+  EXPECT_NE(report.find("focal estimated"), std::string::npos) << report;
+  EXPECT_NE(report.find("12 frames did not converge: 10 11 12 13 14 15 16 17 "
+                        "18 19 ..."),
+            std::string::npos)
+      << report;
+  EXPECT_EQ(report.find("converged\n"), std::string::npos) << report;
 }
 
 TEST(Bundle, BadOptionsAreConfigErrors) {

@@ -9,6 +9,7 @@
 
 #include "common/error.h"
 #include "env/env_fixture.h"
+#include "env/task.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -325,6 +326,45 @@ TEST(Checkpoint, InitialStateBuffersRoundTrip) {
       EXPECT_EQ(b.state.mocap_quat, a.state.mocap_quat);
     }
   }
+  fs::remove_all(dir);
+}
+
+// Buffers saved for one task (truth: one per bundle) cannot be loaded into
+// another (estimate: one per view): a clear error, not a silent mix-up.
+TEST(Checkpoint, InitialStateBuffersOfAnotherTaskAreRejected) {
+  const std::string dir = testing::TempDir("checkpoint_buffers");
+  const std::string path = dir + "/checkpoint.pt";
+  TrackingTaskOptions options;
+  auto character = testing::LoadHumanoid(options.simulation);
+  ReferenceBundle bundle = testing::MakeGlidingBundle(*character, 0.5);
+  bundle.estimate = testing::EstimateFromTruth(bundle, {{0.5, {1, 0, 0}}});
+  TrackingTask truth = BuildTrackingTask(character, {bundle}, options);
+  options.sources = {InitialStateSource::kEstimate, CameraSource::kEstimate};
+  TrackingTask estimate = BuildTrackingTask(character, {bundle}, options);
+  ASSERT_EQ(truth.initial_states->num_buffers(), 1);
+  ASSERT_EQ(estimate.initial_states->num_buffers(), 2);
+  const SimState state_template =
+      Simulation(character, options.simulation).Save();
+  TrainedModel saved = MakeTrainedModel(SmallLayout(), kActions, 1);
+  SaveCheckpoint(path, TrainConfig(), saved.model, *saved.optimizer,
+                 CheckpointCounters(), truth.initial_states.get(),
+                 state_template);
+
+  TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 2);
+  try {
+    LoadCheckpoint(path, loaded.model, loaded.optimizer.get(),
+                   estimate.initial_states.get(), state_template);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find("holds 1 initial-state buffers but this task has 2"),
+              std::string::npos)
+        << message;
+  }
+  // The same task loads.
+  EXPECT_NO_THROW(LoadCheckpoint(path, loaded.model, loaded.optimizer.get(),
+                                 truth.initial_states.get(), state_template));
   fs::remove_all(dir);
 }
 

@@ -6,7 +6,9 @@
 #include <chrono>
 
 #include "env/env_fixture.h"
+#include "env/task.h"
 #include "eval/evaluator.h"
+#include "fit/fit.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
 #include "rl/torch_policy.h"
@@ -23,8 +25,25 @@ constexpr int64_t kTrainingSamples = 200'000;
 constexpr double kMinSurvivalGain = 1.6;    // measured 2.6x
 constexpr double kMinTrainedFrames = 18.0;  // measured 26.8
 
+// Small networks and batches so that it learns in CI time.
+void UseCiSizedLearning(const std::string& dir, TrainConfig* config) {
+  config->model.encoder_hidden = {128};
+  config->model.encoder_features = 64;
+  config->model.policy_hidden = {256, 128};
+  config->model.critic_hidden = {256, 128};
+  config->ppo.num_envs = 32;
+  config->ppo.steps_per_env = 32;
+  config->ppo.minibatch_size = 256;
+  config->ppo.learning_rate = 5e-4;
+  config->run.run_dir = dir + "/run";
+  config->run.seed = 7;
+  config->run.total_samples = kTrainingSamples;
+  config->Validate();
+}
+
 TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
-  M2D_REQUIRE_SHARED(walk_path, "deepmimic/motions/humanoid3d_walk.txt");
+  const std::string walk_path =
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
   std::string dir = testing::TempDir("learning");
 
   // The reference: 2 s of walking, 4 following views.
@@ -37,19 +56,7 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
   config.data.bundles = {dir + "/walk2s.json"};
   WriteBundle(config.data.bundles[0], bundle);
 
-  // Small networks and batches so that it learns in CI time.
-  config.model.encoder_hidden = {128};
-  config.model.encoder_features = 64;
-  config.model.policy_hidden = {256, 128};
-  config.model.critic_hidden = {256, 128};
-  config.ppo.num_envs = 32;
-  config.ppo.steps_per_env = 32;
-  config.ppo.minibatch_size = 256;
-  config.ppo.learning_rate = 5e-4;
-  config.run.run_dir = dir + "/run";
-  config.run.seed = 7;
-  config.run.total_samples = kTrainingSamples;
-  config.Validate();
+  UseCiSizedLearning(dir, &config);
 
   Trainer trainer(config, /*resume=*/false);
   auto start = std::chrono::steady_clock::now();
@@ -89,6 +96,72 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
   EXPECT_GT(after.mean_frames, before.mean_frames * kMinSurvivalGain);
   EXPECT_GT(after.mean_frames, kMinTrainedFrames);
   EXPECT_LT(after.e2d_px, before.e2d_px);
+}
+
+// Calibrated on this machine (issue 11): the same run from 2D only — the
+// bundle stripped of its 3D truth and cameras, then fitted; training and
+// evaluation start from the fitted poses and project with the fitted
+// cameras. Measured (4 views, moving cameras, 200k samples): frames before
+// the early exit 10.6 -> 14.2 of 45, E2D 31.5 -> 20.7 px. Less than from
+// 3D truth: the fit keeps the walker's travel out of its following cameras
+// (docs/fit.md, "Known limits"), so the starts ask for a walk in place.
+constexpr double kMin2dSurvivalGain = 1.15;  // measured 1.34x
+constexpr double kMax2dErrorRatio = 0.85;    // measured 0.66
+
+TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
+  const std::string walk_path =
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
+  std::string dir = testing::TempDir("learning2d");
+
+  // What a user has: 2 s of walking in 4 following views, no 3D, no
+  // cameras. The fit estimates both.
+  TrainConfig config;
+  config.data.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  auto character = LoadCharacterForSimulation(config.data.character_config,
+                                              "flat", config.env.simulation);
+  ReferenceBundle stripped =
+      StripBundle(testing::MakeWalkBundle(walk_path, *character, 2.0));
+  ASSERT_FALSE(stripped.ground_truth.has_value());
+  FitOptions fit;
+  fit.camera_motion = CameraMotion::kMoving;
+  fit.num_threads = 2;
+  ReferenceBundle fitted = FitBundle(stripped, *character, fit, "walk2s");
+  config.data.bundles = {dir + "/walk2s_fitted.json"};
+  WriteBundle(config.data.bundles[0], fitted);
+  config.data.initial_states = InitialStateSource::kEstimate;
+  config.data.cameras = CameraSource::kEstimate;
+
+  UseCiSizedLearning(dir, &config);
+
+  Trainer trainer(config, /*resume=*/false);
+  TrainSummary summary = trainer.Run(0, nullptr, nullptr);
+
+  // Evaluated as trained: fitted starts and cameras.
+  TrackingTask task =
+      BuildTrackingTask(character, {fitted}, TrainingTaskOptions(config));
+  EvalOptions eval;
+  eval.episodes_per_view = 3;
+  eval.episode_s = 1.5;
+  TorchPolicy trained(summary.checkpoint_path);
+  EvalRow after =
+      AggregateRows(EvaluatePolicy(trained, character, task.reference,
+                                   task.initial_states, config.env, eval));
+  TrainConfig untrained_config = config;
+  untrained_config.run.run_dir = dir + "/untrained";
+  Trainer untrained_trainer(untrained_config, false);
+  untrained_trainer.SaveCheckpoint();
+  TorchPolicy untrained(untrained_trainer.checkpoint_path());
+  EvalRow before =
+      AggregateRows(EvaluatePolicy(untrained, character, task.reference,
+                                   task.initial_states, config.env, eval));
+  std::printf(
+      "from 2D only: untrained: Succ %.2f E2D %.1f px frames %.1f | trained: "
+      "Succ %.2f E2D %.1f px frames %.1f\n",
+      before.succ, before.e2d_px, before.mean_frames, after.succ, after.e2d_px,
+      after.mean_frames);
+  EXPECT_GT(after.mean_frames, before.mean_frames * kMin2dSurvivalGain);
+  EXPECT_LT(after.e2d_px, before.e2d_px * kMax2dErrorRatio);
 }
 
 }  // namespace

@@ -60,7 +60,42 @@ void ExpectConfigError(const std::string& text, const std::string& needle,
   }
 }
 
+TEST(TrainConfig, SourcesDefaultToTheTruthAndRoundTrip) {
+  std::string dir = testing::TempDir("train_config_sources");
+  TrainConfig defaults =
+      LoadTrainConfig(Write(dir, "a.yaml", "data: {bundles: [a.json]}\n"));
+  EXPECT_EQ(defaults.data.initial_states, InitialStateSource::kTruth);
+  EXPECT_EQ(defaults.data.cameras, CameraSource::kTruth);
+  TrainConfig config = LoadTrainConfig(
+      Write(dir, "b.yaml",
+            "data: {bundles: [a.json], initial_states: estimate, cameras: "
+            "estimate}\n"));
+  EXPECT_EQ(config.data.initial_states, InitialStateSource::kEstimate);
+  EXPECT_EQ(config.data.cameras, CameraSource::kEstimate);
+  const std::string yaml = TrainConfigToYaml(config);
+  EXPECT_NE(yaml.find("initial_states: estimate"), std::string::npos) << yaml;
+  TrainConfig again = LoadTrainConfigText(yaml, "text");
+  EXPECT_EQ(again.data.initial_states, InitialStateSource::kEstimate);
+  EXPECT_EQ(again.data.cameras, CameraSource::kEstimate);
+  TrainingTaskOptions(again);  // carries them into the task
+  EXPECT_EQ(TrainingTaskOptions(again).sources.cameras,
+            CameraSource::kEstimate);
+  // A checkpoint's embedded config from before the sources: the truth.
+  std::string old_yaml = TrainConfigToYaml(defaults);
+  for (const char* key : {"  initial_states: truth\n", "  cameras: truth\n"})
+    old_yaml.erase(old_yaml.find(key), std::string(key).size());
+  EXPECT_EQ(LoadTrainConfigText(old_yaml, "old").data.sources().cameras,
+            CameraSource::kTruth);
+}
+
 TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
+  ExpectConfigError("data: {bundles: [a.json], initial_states: fitted}\n",
+                    "'data.initial_states' is not known");
+  ExpectConfigError("data: {bundles: [a.json], cameras: default}\n",
+                    "'data.cameras' is not known");
+  ExpectConfigError(
+      "data: {bundles: [a.json], initial_states: estimate, cameras: truth}\n",
+      "initial_states: estimate needs cameras: estimate");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envz: 3}\n",
                     "'agent.num_envz' is not a known setting");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envs: many}\n",

@@ -1,0 +1,105 @@
+// cli: `mimic2d fit` — estimates each view's camera and the character's
+// per-frame 3D poses from the 2D alone, and writes them into the bundle's
+// `estimate` section (docs/fit.md).
+#include <cstdio>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "common/error.h"
+#include "fit/fit.h"
+#include "motion/bundle.h"
+#include "sim/simulation.h"
+
+namespace m2d::cli {
+namespace {
+
+struct FitArgs {
+  std::string input;
+  std::string output;
+  std::string camera = "static";
+  std::string character = "characters/humanoid.yaml";
+  FitOptions options;
+  bool quiet = false;
+};
+
+// More than this share of a view's frames unconverged fails the command
+// (the estimate is still written, for inspection).
+constexpr double kMaxUnconvergedFraction = 0.25;
+
+int RunFit(FitArgs& args) {
+  if (!ParseCameraMotion(args.camera, &args.options.camera_motion)) {
+    throw ConfigError("--camera must be static or moving, not '" + args.camera +
+                      "'");
+  }
+  if (!args.quiet) {
+    args.options.progress = [](const std::string& line) {
+      std::printf("    %s\n", line.c_str());
+      std::fflush(stdout);
+    };
+  }
+  args.options.Validate();
+  const ReferenceBundle bundle = ReadBundle(args.input);
+  const std::string character_path = args.character.find('/') == 0
+                                         ? args.character
+                                         : AssetPath(args.character);
+  auto character =
+      LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
+  std::printf("fitting %zu view(s) of %s (%d frames), camera %s, focal %s\n",
+              bundle.views.size(), args.input.c_str(), bundle.num_frames(),
+              args.camera.c_str(),
+              args.options.fixed_focal_px > 0 ? "fixed" : "estimated");
+  int failed_views = 0;
+  ReferenceBundle fitted = FitBundle(
+      bundle, *character, args.options, args.input,
+      [&](int view, const ViewEstimate& estimate) {
+        const FitSummary& summary = estimate.summary;
+        std::printf("view %d/%zu (%s): %s\n", view + 1, bundle.views.size(),
+                    bundle.views[view].name.c_str(),
+                    summary.BriefReport().c_str());
+        if (summary.unconverged_frames.size() >
+            kMaxUnconvergedFraction * summary.num_frames) {
+          ++failed_views;
+        }
+        std::fflush(stdout);
+      });
+  WriteBundle(args.output, fitted);
+  std::printf("wrote %s\n", args.output.c_str());
+  if (failed_views > 0) {
+    std::fprintf(stderr,
+                 "error: %s: the fit did not converge on more than %.0f%% of "
+                 "the frames of %d view(s) (listed above); the estimate was "
+                 "written for inspection but should not be trained on\n",
+                 args.input.c_str(), 100 * kMaxUnconvergedFraction,
+                 failed_views);
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddFitCommand(CLI::App& app, CommandRun* run) {
+  auto args = std::make_shared<FitArgs>();
+  CLI::App* fit = app.add_subcommand(
+      "fit",
+      "Estimate each view's camera and the character's 3D poses from its 2D "
+      "keypoints alone (Ceres), into the bundle's estimate section");
+  fit->add_option("input", args->input, "reference bundle (2D; truth unused)")
+      ->required();
+  fit->add_option("-o,--output", args->output, "bundle with the estimate")
+      ->required();
+  fit->add_option("--camera", args->camera,
+                  "static (tripod) or moving (smooth per-frame position)")
+      ->default_val("static");
+  fit->add_option("--focal", args->options.fixed_focal_px,
+                  "known focal length in pixels (default: estimated)");
+  fit->add_option("--character", args->character,
+                  "character config (relative to assets/ unless absolute)")
+      ->default_val("characters/humanoid.yaml");
+  fit->add_option("--threads", args->options.num_threads, "solver threads")
+      ->default_val(1);
+  fit->add_flag("--quiet", args->quiet, "no per-stage progress lines");
+  fit->callback([run, args] { *run = [args] { return RunFit(*args); }; });
+}
+
+}  // namespace m2d::cli

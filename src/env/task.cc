@@ -1,0 +1,44 @@
+#include "env/task.h"
+
+#include "common/error.h"
+
+namespace m2d {
+
+TrackingTask BuildTrackingTask(std::shared_ptr<const Character> character,
+                               std::vector<ReferenceBundle> bundles,
+                               const TrackingTaskOptions& options) {
+  TrackingTask task;
+  task.character = std::move(character);
+  task.reference = TrackingReference::Prepare(
+      std::move(bundles), *task.character, options.simulation.control_hz,
+      options.sources);
+  task.initial_states = std::make_shared<InitialStates>(
+      *task.reference, task.character, options.simulation, options.buffer,
+      options.initial_state_noise_rad, options.noise_seed);
+  return task;
+}
+
+TrackingTask BuildTrackingTask(const std::string& character_config,
+                               const std::string& scene,
+                               const std::vector<std::string>& bundle_paths,
+                               const TrackingTaskOptions& options) {
+  auto character =
+      LoadCharacterForSimulation(character_config, scene, options.simulation);
+  std::vector<ReferenceBundle> bundles;
+  for (const std::string& path : bundle_paths)
+    bundles.push_back(ReadBundle(path));
+  std::vector<std::string> names;
+  for (const ReferenceBundle& bundle : bundles) names.push_back(bundle.name);
+  try {
+    return BuildTrackingTask(std::move(character), std::move(bundles), options);
+  } catch (const InputError& e) {
+    // Name the file the user gave rather than the bundle's inner name.
+    for (size_t b = 0; b < names.size(); ++b) {
+      if (e.source() == names[b])
+        throw InputError(bundle_paths[b], e.problem());
+    }
+    throw;
+  }
+}
+
+}  // namespace m2d

@@ -1,0 +1,139 @@
+#include "eval/fit_accuracy.h"
+
+#include <cmath>
+#include <string>
+
+#include "common/error.h"
+#include "eval/metrics.h"
+#include "fit/camera_model.h"
+#include "motion/motion3d.h"
+#include "sim/character.h"
+
+namespace m2d {
+namespace {
+
+constexpr char kSource[] = "fit accuracy";
+
+double Degrees(double radians) { return radians * 180.0 / M_PI; }
+
+// |a - b| wrapped to [0, pi].
+double AngleGapRad(double a, double b) {
+  return std::abs(std::remainder(a - b, 2.0 * M_PI));
+}
+
+void CheckCameraCount(size_t count, int num_frames, const char* what) {
+  if (count != 1 && count != static_cast<size_t>(num_frames)) {
+    throw InputError(
+        kSource, std::string(what) + " has " + std::to_string(count) +
+                     " cameras; expected 1 or " + std::to_string(num_frames));
+  }
+}
+
+}  // namespace
+
+FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
+                               const std::vector<PinholeCamera>& true_cameras,
+                               const GroundTruth3D& truth,
+                               const Character& character) {
+  // Outline: check shapes; camera errors per frame (once when both are
+  // static); keypoints of the fitted poses against the truth's; the
+  // summary's reprojection and time.
+  const int num_frames = static_cast<int>(estimate.poses.size());
+  if (num_frames == 0) throw InputError(kSource, "the estimate has no poses");
+  if (truth.keypoints_m.size() != estimate.poses.size()) {
+    throw InputError(kSource, "the estimate has " + std::to_string(num_frames) +
+                                  " poses, the truth " +
+                                  std::to_string(truth.keypoints_m.size()) +
+                                  " frames");
+  }
+  if (estimate.skeleton_name != character.skeleton().name) {
+    throw InputError(
+        kSource, "the estimate poses skeleton '" + estimate.skeleton_name +
+                     "', the character is '" + character.skeleton().name + "'");
+  }
+  CheckCameraCount(estimate.cameras.size(), num_frames, "the estimate");
+  CheckCameraCount(true_cameras.size(), num_frames, "the true view");
+
+  FitAccuracy accuracy;
+  accuracy.num_frames = num_frames;
+  const bool both_static =
+      estimate.cameras.size() == 1 && true_cameras.size() == 1;
+  const int camera_frames = both_static ? 1 : num_frames;
+  for (int t = 0; t < camera_frames; ++t) {
+    const PinholeCamera& ours = estimate.CameraAt(t);
+    const PinholeCamera& theirs =
+        true_cameras.size() == 1 ? true_cameras[0] : true_cameras[t];
+    const double focal = ours.intrinsics().fx_px;
+    const double true_focal = theirs.intrinsics().fx_px;
+    const Eigen::Vector2d angles = CameraPitchRollRad(ours);
+    const Eigen::Vector2d true_angles = CameraPitchRollRad(theirs);
+    accuracy.focal_error_pct +=
+        100.0 * std::abs(focal - true_focal) / true_focal / camera_frames;
+    accuracy.pitch_error_deg +=
+        Degrees(AngleGapRad(angles[0], true_angles[0])) / camera_frames;
+    accuracy.roll_error_deg +=
+        Degrees(AngleGapRad(angles[1], true_angles[1])) / camera_frames;
+    if (t == 0) {
+      accuracy.focal_px = focal;
+      accuracy.true_focal_px = true_focal;
+      accuracy.pitch_deg = Degrees(angles[0]);
+      accuracy.true_pitch_deg = Degrees(true_angles[0]);
+      accuracy.roll_deg = Degrees(angles[1]);
+      accuracy.true_roll_deg = Degrees(true_angles[1]);
+    }
+  }
+
+  KeypointFrames fitted;
+  fitted.reserve(num_frames);
+  for (const Pose3D& pose : estimate.poses) {
+    fitted.push_back(KeypointPositions(character.skeleton(),
+                                       character.keypoint_map(), pose));
+    if (fitted.back().size() != truth.keypoints_m.front().size()) {
+      throw InputError(
+          kSource, "the character has " + std::to_string(fitted.back().size()) +
+                       " keypoints, the truth " +
+                       std::to_string(truth.keypoints_m.front().size()));
+    }
+  }
+  accuracy.root_relative_mpjpe_mm =
+      1000.0 *
+      YawAlignedRootRelativeError(fitted, truth.keypoints_m, *truth.layout);
+  accuracy.pa_mpjpe_mm =
+      1000.0 * ProcrustesAlignedError(fitted, truth.keypoints_m);
+
+  const FitSummary& summary = estimate.summary;
+  accuracy.mean_reprojection_px = summary.mean_reprojection_px;
+  accuracy.seconds_per_100_frames = 100.0 * summary.seconds / num_frames;
+  accuracy.unconverged_fraction =
+      static_cast<double>(summary.unconverged_frames.size()) / num_frames;
+  return accuracy;
+}
+
+FitAccuracy MeanFitAccuracy(const std::vector<FitAccuracy>& accuracies) {
+  FitAccuracy mean;
+  if (accuracies.empty()) return mean;
+  const double n = static_cast<double>(accuracies.size());
+  double frames = 0.0;
+  for (const FitAccuracy& a : accuracies) {
+    frames += a.num_frames;
+    mean.focal_error_pct += a.focal_error_pct / n;
+    mean.pitch_error_deg += a.pitch_error_deg / n;
+    mean.roll_error_deg += a.roll_error_deg / n;
+    mean.focal_px += a.focal_px / n;
+    mean.true_focal_px += a.true_focal_px / n;
+    mean.pitch_deg += a.pitch_deg / n;
+    mean.true_pitch_deg += a.true_pitch_deg / n;
+    mean.roll_deg += a.roll_deg / n;
+    mean.true_roll_deg += a.true_roll_deg / n;
+    mean.root_relative_mpjpe_mm += a.root_relative_mpjpe_mm / n;
+    mean.pa_mpjpe_mm += a.pa_mpjpe_mm / n;
+    mean.mean_reprojection_px += a.mean_reprojection_px / n;
+    mean.seconds_per_100_frames += a.seconds_per_100_frames / n;
+    mean.unconverged_fraction += a.unconverged_fraction / n;
+    mean.cpu_seconds_per_100_frames += a.cpu_seconds_per_100_frames / n;
+  }
+  mean.num_frames = static_cast<int>(std::lround(frames / n));
+  return mean;
+}
+
+}  // namespace m2d

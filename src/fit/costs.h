@@ -1,0 +1,285 @@
+// fit: the terms of the fit's objective as Ceres cost functors (templated,
+// for automatic differentiation). docs/fit.md writes each one out. Every
+// functor returns weighted residuals; Ceres minimizes half their squared sum.
+#ifndef MIMIC2D_FIT_COSTS_H_
+#define MIMIC2D_FIT_COSTS_H_
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <vector>
+
+#include "fit/camera_model.h"
+#include "fit/kinematics.h"
+
+namespace m2d {
+
+// Per-coordinate Geman-McClure as a residual: its square is SMPLify's GMoF
+// sigma^2 x^2 / (sigma^2 + x^2); smooth, ~x near 0, bounded by sigma.
+template <typename T>
+T GemanMcClureResidual(const T& x, double sigma) {
+  using std::sqrt;
+  return x * T(sigma) / sqrt(T(sigma * sigma) + x * x);
+}
+
+// One frame's terms, sharing one forward-kinematics pass. Parameter blocks:
+// focal (1), camera pitch and roll (2), camera centre (3), root position
+// (3), root quaternion (4), hinge angles (model.num_hinges()). Residuals:
+//  - reprojection, 2 per keypoint: weight x Geman-McClure of the pixel
+//    error in units of the person's image size (0 for unused keypoints);
+//  - ground, 1: the lowest sole point's height, bounded Geman-McClure style
+//    by `airborne_m` so that a jump is not pulled down;
+//  - penetration, 1 per sole point: its height when below z = 0;
+//  - upright, 2: the horizontal part of the root's up axis (people stand
+//    upright on average; it keeps camera roll from hiding in a lean).
+struct FrameCost {
+  const KinematicModel* model;
+  std::vector<Eigen::Vector2d> observed_px;  // per keypoint
+  std::vector<double> weights;               // per keypoint (0: unused)
+  double cx_px = 0.0, cy_px = 0.0;
+  double inv_scale_px = 1.0;  // 1 / the person's image size
+  double sigma = 0.5;         // Geman-McClure sigma, same units
+  double ground_weight = 0.0;
+  double penetration_weight = 0.0;
+  double airborne_m = 0.15;
+  double upright_weight = 0.0;
+
+  static int NumResiduals(const KinematicModel& model) {
+    return 2 * model.num_keypoints() + 1 + model.num_sole_points() + 2;
+  }
+
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residuals) const {
+    const int num_keypoints = model->num_keypoints();
+    const int num_soles = model->num_sole_points();
+    constexpr int kMaxPoints = 128;  // FromCharacter checks the count
+    T points[3 * kMaxPoints];
+    CharacterPoints(*model, blocks[3], blocks[4], blocks[5], points);
+    T* out = residuals;
+    for (int j = 0; j < num_keypoints; ++j, out += 2) {
+      if (weights[j] == 0.0) {
+        out[0] = out[1] = T(0);
+        continue;
+      }
+      T pixel[2];
+      FitProject(blocks[0][0], blocks[1], blocks[2], &points[3 * j], cx_px,
+                 cy_px, pixel);
+      for (int k = 0; k < 2; ++k) {
+        const T error = (pixel[k] - T(observed_px[j][k])) * T(inv_scale_px);
+        out[k] = T(weights[j]) * GemanMcClureResidual(error, sigma);
+      }
+    }
+    T lowest = points[3 * num_keypoints + 2];
+    for (int s = 0; s < num_soles; ++s) {
+      const T& z = points[3 * (num_keypoints + s) + 2];
+      if (z < lowest) lowest = z;
+      out[1 + s] = z < T(0) ? T(penetration_weight) * z : T(0);
+    }
+    out[0] = T(ground_weight) * GemanMcClureResidual(lowest, airborne_m);
+    out += 1 + num_soles;
+    // The root's up axis is the third column of its rotation.
+    const T* q = blocks[4];
+    const T norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    out[0] = T(upright_weight) * T(2) * (q[1] * q[3] + q[0] * q[2]) / norm2;
+    out[1] = T(upright_weight) * T(2) * (q[2] * q[3] - q[0] * q[1]) / norm2;
+    return true;
+  }
+
+  static ceres::CostFunction* Create(FrameCost cost) {
+    const int num_hinges = cost.model->num_hinges();
+    const int num_residuals = NumResiduals(*cost.model);
+    auto* function = new ceres::DynamicAutoDiffCostFunction<FrameCost, 16>(
+        new FrameCost(std::move(cost)));
+    for (int size : {1, 2, 3, kRootPositionSize, kRootQuaternionSize})
+      function->AddParameterBlock(size);
+    function->AddParameterBlock(num_hinges);
+    function->SetNumResiduals(num_residuals);
+    return function;
+  }
+};
+
+// Feet that do not slide (blocks: frame t's root position, quaternion,
+// hinges, then frame t+1's): each sole point's horizontal step, weighted by
+// how surely it is in contact (fixed during a solve).
+struct FootSlideCost {
+  const KinematicModel* model;
+  std::vector<double> contact_weights;  // per sole point
+
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residuals) const {
+    const int num_keypoints = model->num_keypoints();
+    const int num_soles = model->num_sole_points();
+    constexpr int kMaxPoints = 128;  // FromCharacter checks the count
+    T before[3 * kMaxPoints], after[3 * kMaxPoints];
+    CharacterPoints(*model, blocks[0], blocks[1], blocks[2], before);
+    CharacterPoints(*model, blocks[3], blocks[4], blocks[5], after);
+    for (int s = 0; s < num_soles; ++s) {
+      const int at = 3 * (num_keypoints + s);
+      for (int k = 0; k < 2; ++k) {
+        residuals[2 * s + k] =
+            T(contact_weights[s]) * (after[at + k] - before[at + k]);
+      }
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(FootSlideCost cost) {
+    const int num_hinges = cost.model->num_hinges();
+    const int num_residuals = 2 * cost.model->num_sole_points();
+    auto* function = new ceres::DynamicAutoDiffCostFunction<FootSlideCost, 16>(
+        new FootSlideCost(std::move(cost)));
+    for (int frame = 0; frame < 2; ++frame) {
+      function->AddParameterBlock(kRootPositionSize);
+      function->AddParameterBlock(kRootQuaternionSize);
+      function->AddParameterBlock(num_hinges);
+    }
+    function->SetNumResiduals(num_residuals);
+    return function;
+  }
+};
+
+// weight x (value - prior), element-wise over one block (pose prior: hinge
+// angles toward the rest pose's 0).
+struct PriorCost {
+  int size;
+  double weight;
+
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residuals) const {
+    for (int i = 0; i < size; ++i) residuals[i] = T(weight) * blocks[0][i];
+    return true;
+  }
+
+  static ceres::CostFunction* Create(int size, double weight) {
+    auto* function = new ceres::DynamicAutoDiffCostFunction<PriorCost, 16>(
+        new PriorCost{size, weight});
+    function->AddParameterBlock(size);
+    function->SetNumResiduals(size);
+    return function;
+  }
+};
+
+// weight x (a - 2 b + c) over three consecutive frames' blocks of one size:
+// acceleration (hinges, root position, camera centre).
+struct AccelerationCost {
+  int size;
+  double weight;
+
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residuals) const {
+    for (int i = 0; i < size; ++i) {
+      residuals[i] =
+          T(weight) * (blocks[0][i] - T(2) * blocks[1][i] + blocks[2][i]);
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(int size, double weight) {
+    auto* function =
+        new ceres::DynamicAutoDiffCostFunction<AccelerationCost, 16>(
+            new AccelerationCost{size, weight});
+    for (int k = 0; k < 3; ++k) function->AddParameterBlock(size);
+    function->SetNumResiduals(size);
+    return function;
+  }
+};
+
+// weight x (b - a) for two consecutive 3-vectors (a moving camera's speed:
+// a weak preference for a still camera, which fixes the split of a shared
+// drift between camera and subject until the feet pin the subject).
+struct VelocityCost {
+  double weight;
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* residuals) const {
+    for (int i = 0; i < 3; ++i) residuals[i] = T(weight) * (b[i] - a[i]);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double weight) {
+    return new ceres::AutoDiffCostFunction<VelocityCost, 3, 3, 3>(
+        new VelocityCost{weight});
+  }
+};
+
+// Angular acceleration of the root orientation over three frames: the
+// change between consecutive relative rotations (as rotation vectors).
+struct TurnAccelerationCost {
+  double weight;
+
+  template <typename T>
+  static void RelativeRotation(const T* from, const T* to, T* rotation_vector) {
+    using std::sqrt;
+    T inverse[4] = {from[0], -from[1], -from[2], -from[3]};
+    const T norm_from = from[0] * from[0] + from[1] * from[1] +
+                        from[2] * from[2] + from[3] * from[3];
+    T relative[4];
+    ceres::QuaternionProduct(to, inverse, relative);
+    const T norm_to =
+        to[0] * to[0] + to[1] * to[1] + to[2] * to[2] + to[3] * to[3];
+    const T scale = T(1) / sqrt(norm_from * norm_to);
+    for (T& value : relative) value *= scale;
+    if (relative[0] < T(0))
+      for (T& value : relative) value = -value;
+    ceres::QuaternionToAngleAxis(relative, rotation_vector);
+  }
+
+  template <typename T>
+  bool operator()(const T* a, const T* b, const T* c, T* residuals) const {
+    T first[3], second[3];
+    RelativeRotation(a, b, first);
+    RelativeRotation(b, c, second);
+    for (int i = 0; i < 3; ++i)
+      residuals[i] = T(weight) * (second[i] - first[i]);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double weight) {
+    return new ceres::AutoDiffCostFunction<TurnAccelerationCost, 3, 4, 4, 4>(
+        new TurnAccelerationCost{weight});
+  }
+};
+
+// weight x log(value / prior) on one element of a block: the focal length,
+// the camera's height.
+struct LogPriorCost {
+  double prior;
+  double weight;
+  int index = 0;
+
+  template <typename T>
+  bool operator()(const T* block, T* residual) const {
+    using std::log;
+    residual[0] = T(weight) * log(block[index] / T(prior));
+    return true;
+  }
+
+  static ceres::CostFunction* CreateOnHeight(double prior_m, double weight) {
+    return new ceres::AutoDiffCostFunction<LogPriorCost, 1, 3>(
+        new LogPriorCost{prior_m, weight, 2});
+  }
+};
+
+// weight x log(focal / prior).
+struct FocalPriorCost {
+  double prior_px;
+  double weight;
+
+  template <typename T>
+  bool operator()(const T* focal_px, T* residual) const {
+    using std::log;
+    residual[0] = T(weight) * log(focal_px[0] / T(prior_px));
+    return true;
+  }
+
+  static ceres::CostFunction* Create(double prior_px, double weight) {
+    return new ceres::AutoDiffCostFunction<FocalPriorCost, 1, 1>(
+        new FocalPriorCost{prior_px, weight});
+  }
+};
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_FIT_COSTS_H_

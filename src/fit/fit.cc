@@ -1,0 +1,731 @@
+#include "fit/fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "common/error.h"
+#include "fit/camera_model.h"
+#include "fit/costs.h"
+#include "fit/kinematics.h"
+#include "motion/canonical.h"
+#include "sim/character.h"
+
+namespace m2d {
+namespace {
+
+// The clip as the fit uses it: confident keypoints with their weights, and
+// per frame the person's root and size in the image.
+struct Observations {
+  int num_frames = 0;
+  int num_keypoints = 0;
+  int width_px = 0;
+  int height_px = 0;
+  std::vector<Eigen::Vector2d> pixel_px;  // T x J, frame-major
+  std::vector<double> weight;             // T x J: confidence, 0 = unused
+  std::vector<char> usable;               // per frame: enough keypoints
+  std::vector<Eigen::Vector2d> root_px;   // per frame (gaps carried over)
+  std::vector<double> scale_px;           // per frame: RMS keypoint spread
+  double median_scale_px = 0.0;
+
+  double Weight(int t, int j) const { return weight[t * num_keypoints + j]; }
+  const Eigen::Vector2d& Pixel(int t, int j) const {
+    return pixel_px[t * num_keypoints + j];
+  }
+};
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2,
+                   values.end());
+  return values[values.size() / 2];
+}
+
+Observations ReadObservations(const Clip2D& clip, const FitOptions& options,
+                              const std::string& source) {
+  // Outline: reject clips the fit cannot use (too short, coordinates far
+  // outside the image, too few usable frames, a tiny person), keep the
+  // confident keypoints, measure each frame's root and size.
+  Observations obs;
+  obs.num_frames = clip.num_frames();
+  obs.num_keypoints = clip.layout->num_keypoints();
+  obs.width_px = clip.image_width_px;
+  obs.height_px = clip.image_height_px;
+  if (obs.num_frames < options.min_frames) {
+    throw InputError(source, "clip has " + std::to_string(obs.num_frames) +
+                                 " frames; the fit needs at least " +
+                                 std::to_string(options.min_frames));
+  }
+  obs.pixel_px.resize(static_cast<size_t>(obs.num_frames) * obs.num_keypoints);
+  obs.weight.assign(obs.pixel_px.size(), 0.0);
+  obs.usable.assign(obs.num_frames, 0);
+  int num_usable = 0;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    int confident = 0;
+    for (int j = 0; j < obs.num_keypoints; ++j) {
+      const Keypoint2D& point = clip.keypoints.at(t, j);
+      if (!point.IsPresent()) continue;
+      if (!std::isfinite(point.x_px) || !std::isfinite(point.y_px)) {
+        throw InputError(source, "frame " + std::to_string(t) + " keypoint " +
+                                     clip.layout->keypoint_names[j] +
+                                     " has a non-finite coordinate");
+      }
+      // A detector may place a keypoint a little outside the image; one an
+      // image size away is a broken file, not a detection.
+      if (point.x_px < -obs.width_px || point.x_px > 2.0 * obs.width_px ||
+          point.y_px < -obs.height_px || point.y_px > 2.0 * obs.height_px) {
+        char where[160];
+        std::snprintf(where, sizeof(where),
+                      "frame %d keypoint %s at (%.0f, %.0f) px is far "
+                      "outside the %dx%d image",
+                      t, clip.layout->keypoint_names[j].c_str(), point.x_px,
+                      point.y_px, obs.width_px, obs.height_px);
+        throw InputError(source, where);
+      }
+      obs.pixel_px[t * obs.num_keypoints + j] = point.Pixel();
+      if (point.confidence >= options.min_confidence) {
+        obs.weight[t * obs.num_keypoints + j] = point.confidence;
+        ++confident;
+      }
+    }
+    if (confident >= options.min_keypoints_per_frame) {
+      obs.usable[t] = 1;
+      ++num_usable;
+    } else {
+      for (int j = 0; j < obs.num_keypoints; ++j)
+        obs.weight[t * obs.num_keypoints + j] = 0.0;
+    }
+  }
+  if (num_usable < options.min_usable_fraction * obs.num_frames) {
+    char problem[200];
+    std::snprintf(problem, sizeof(problem),
+                  "only %d of %d frames have %d or more keypoints with "
+                  "confidence >= %.2f; the fit needs %.0f%% of the frames",
+                  num_usable, obs.num_frames, options.min_keypoints_per_frame,
+                  options.min_confidence, 100.0 * options.min_usable_fraction);
+    throw InputError(source, problem);
+  }
+  FrameRootsAndScales(clip, source, &obs.root_px, &obs.scale_px);
+  std::vector<double> usable_scales;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    if (obs.usable[t]) usable_scales.push_back(obs.scale_px[t]);
+  }
+  obs.median_scale_px = Median(usable_scales);
+  if (!(obs.median_scale_px >= options.min_person_scale_px)) {
+    char problem[160];
+    std::snprintf(problem, sizeof(problem),
+                  "the person is only %.1f px in size (RMS keypoint spread); "
+                  "the fit needs at least %.1f px",
+                  obs.median_scale_px, options.min_person_scale_px);
+    throw InputError(source, problem);
+  }
+  return obs;
+}
+
+// Every estimated quantity. Vectors are sized once, so block pointers stay
+// valid while Ceres holds them.
+struct Parameters {
+  double focal_px = 0.0;
+  double pitch_roll_rad[2] = {0.0, 0.0};
+  std::vector<Eigen::Vector3d> centres_m;  // 1 (static) or one per frame
+  std::vector<Eigen::Vector3d> root_m;
+  std::vector<Eigen::Vector4d> quaternion_wxyz;
+  std::vector<std::vector<double>> hinges_rad;
+
+  double* centre(int t) {
+    return centres_m.size() == 1 ? centres_m[0].data() : centres_m[t].data();
+  }
+};
+
+// The rest pose's keypoints (root at the origin, identity orientation, all
+// hinges at their start value) and its image-size analogue: the RMS spread
+// about the mean of the layout's root keypoints.
+struct RestPose {
+  std::vector<double> hinges_rad;
+  Eigen::Vector3d root_keypoint_offset_m = Eigen::Vector3d::Zero();
+  double scale_m = 0.0;
+};
+
+RestPose MakeRestPose(const KinematicModel& model,
+                      const KeypointLayout& layout) {
+  RestPose rest;
+  for (int h = 0; h < model.num_hinges(); ++h) {
+    rest.hinges_rad.push_back(
+        std::clamp(0.0, model.hinge_low_rad[h], model.hinge_high_rad[h]));
+  }
+  const double origin[3] = {0, 0, 0};
+  const double identity[4] = {1, 0, 0, 0};
+  std::vector<double> points(3 *
+                             (model.num_keypoints() + model.num_sole_points()));
+  CharacterPoints(model, origin, identity, rest.hinges_rad.data(),
+                  points.data());
+  auto point = [&](int j) {
+    return Eigen::Vector3d(points[3 * j], points[3 * j + 1], points[3 * j + 2]);
+  };
+  for (int index : layout.root_keypoints)
+    rest.root_keypoint_offset_m += point(index);
+  rest.root_keypoint_offset_m /=
+      static_cast<double>(layout.root_keypoints.size());
+  double squared = 0.0;
+  for (int j = 0; j < model.num_keypoints(); ++j)
+    squared += (point(j) - rest.root_keypoint_offset_m).squaredNorm();
+  rest.scale_m = std::sqrt(squared / model.num_keypoints());
+  return rest;
+}
+
+// A start: the rest pose standing on the ray through each frame's 2D root,
+// at the depth where its size matches the 2D size, turned to `yaw_rad`; the
+// camera level, at the height that puts the roots at standing height.
+Parameters InitialParameters(const Observations& obs,
+                             const KinematicModel& model, const RestPose& rest,
+                             const FitOptions& options, double focal_px,
+                             double yaw_rad) {
+  Parameters params;
+  params.focal_px = focal_px;
+  const double cx = 0.5 * obs.width_px, cy = 0.5 * obs.height_px;
+  std::vector<double> depth_m(obs.num_frames);
+  std::vector<double> drop_m;  // how far below the camera each root is
+  for (int t = 0; t < obs.num_frames; ++t) {
+    depth_m[t] = focal_px * rest.scale_m / obs.scale_px[t];
+    if (obs.usable[t])
+      drop_m.push_back(depth_m[t] * (obs.root_px[t].y() - cy) / focal_px);
+  }
+  const double root_height_m =
+      model.standing_root_height_m + rest.root_keypoint_offset_m.z();
+  const double height_m = std::clamp(root_height_m + Median(drop_m), 0.3, 30.0);
+  const int num_centres =
+      options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1;
+  params.centres_m.assign(num_centres, Eigen::Vector3d(0, 0, height_m));
+  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
+  const Eigen::Quaterniond turn(
+      Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()));
+  for (int t = 0; t < obs.num_frames; ++t) {
+    const Eigen::Vector3d ray_camera((obs.root_px[t].x() - cx) / focal_px,
+                                     (obs.root_px[t].y() - cy) / focal_px, 1.0);
+    const Eigen::Vector3d root_keypoints =
+        Eigen::Vector3d(params.centre(t)) +
+        rotation.transpose() * (depth_m[t] * ray_camera);
+    params.root_m.push_back(root_keypoints -
+                            turn * rest.root_keypoint_offset_m);
+    params.quaternion_wxyz.emplace_back(turn.w(), turn.x(), turn.y(), turn.z());
+    params.hinges_rad.push_back(rest.hinges_rad);
+  }
+  return params;
+}
+
+enum class Stage {
+  kRoot,  // camera + root trajectory, torso keypoints, rest pose held
+  kPose,  // + every hinge and keypoint, pose prior
+  kPoseWithContacts,  // + feet that do not slide while in contact
+};
+
+// Per frame and sole point: how surely it touches the floor. Heights count
+// from the frame's lowest sole point, so that only the lower foot holds: a
+// swing foot skims the floor by a few centimetres, and labelling both feet
+// would make walking in place (both sliding) as cheap as walking.
+using ContactWeights = std::vector<std::vector<double>>;
+
+ContactWeights EstimateContacts(Parameters& params, const KinematicModel& model,
+                                const FitOptions& options) {
+  ContactWeights contacts;
+  const int num_keypoints = model.num_keypoints();
+  std::vector<double> points(3 * (num_keypoints + model.num_sole_points()));
+  for (size_t t = 0; t < params.root_m.size(); ++t) {
+    CharacterPoints(model, params.root_m[t].data(),
+                    params.quaternion_wxyz[t].data(),
+                    params.hinges_rad[t].data(), points.data());
+    double lowest_m = std::numeric_limits<double>::infinity();
+    for (int s = 0; s < model.num_sole_points(); ++s)
+      lowest_m = std::min(lowest_m, points[3 * (num_keypoints + s) + 2]);
+    std::vector<double> weights;
+    for (int s = 0; s < model.num_sole_points(); ++s) {
+      // Above the floor (by more than the contact height) nothing holds.
+      const double above_lowest_m =
+          points[3 * (num_keypoints + s) + 2] - lowest_m;
+      const bool near_floor = lowest_m < 2.0 * options.contact_height_m;
+      weights.push_back(
+          near_floor && above_lowest_m < 2.0 * options.contact_height_m
+              ? std::exp(-above_lowest_m / options.contact_height_m)
+              : 0.0);
+    }
+    contacts.push_back(std::move(weights));
+  }
+  return contacts;
+}
+
+// For a moving camera: shifts the subject and the camera together,
+// horizontally, so that the soles in contact stop sliding. Only the
+// relative motion of the two is in the image, so this leaves every
+// reprojection unchanged; it hands stage 3 the subject's travel, which a
+// local solver finds only slowly from a subject walking in place.
+void RemoveContactSlide(const KinematicModel& model,
+                        const ContactWeights& contacts, Parameters& params) {
+  const int num_keypoints = model.num_keypoints();
+  const int num_frames = static_cast<int>(params.root_m.size());
+  std::vector<double> before(3 * (num_keypoints + model.num_sole_points()));
+  std::vector<double> after(before.size());
+  std::vector<Eigen::Vector2d> steps(num_frames, Eigen::Vector2d::Zero());
+  for (int t = 0; t + 1 < num_frames; ++t) {
+    CharacterPoints(model, params.root_m[t].data(),
+                    params.quaternion_wxyz[t].data(),
+                    params.hinges_rad[t].data(), before.data());
+    CharacterPoints(model, params.root_m[t + 1].data(),
+                    params.quaternion_wxyz[t + 1].data(),
+                    params.hinges_rad[t + 1].data(), after.data());
+    double total = 0.0;
+    Eigen::Vector2d slide = Eigen::Vector2d::Zero();
+    for (int s = 0; s < model.num_sole_points(); ++s) {
+      const double weight = std::min(contacts[t][s], contacts[t + 1][s]);
+      const int at = 3 * (num_keypoints + s);
+      slide += weight * Eigen::Vector2d(after[at] - before[at],
+                                        after[at + 1] - before[at + 1]);
+      total += weight;
+    }
+    if (total > 0) steps[t + 1] = -slide / total;
+  }
+  // The subject takes the whole shift; the camera a moving average of it
+  // (a camera moves smoothly while a walker's speed changes every step).
+  std::vector<Eigen::Vector2d> shift(num_frames, Eigen::Vector2d::Zero());
+  for (int t = 1; t < num_frames; ++t) shift[t] = shift[t - 1] + steps[t];
+  constexpr int kHalfWindow = 15;  // frames
+  for (int t = 0; t < num_frames; ++t) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    int count = 0;
+    for (int k = std::max(0, t - kHalfWindow);
+         k <= std::min(num_frames - 1, t + kHalfWindow); ++k) {
+      mean += shift[k];
+      ++count;
+    }
+    params.root_m[t].head<2>() += shift[t];
+    params.centres_m[t].head<2>() += mean / count;
+  }
+  // The world origin stays below the first camera position.
+  const Eigen::Vector2d origin = params.centres_m[0].head<2>();
+  for (int t = 0; t < num_frames; ++t) {
+    params.root_m[t].head<2>() -= origin;
+    params.centres_m[t].head<2>() -= origin;
+  }
+}
+
+// The torso keypoints (shoulders and hips), which the rest pose places well
+// whatever the limbs do: stage 1 fits the camera and root to them.
+std::vector<double> TorsoMask(const KeypointLayout& layout) {
+  std::vector<double> mask(layout.num_keypoints(), 0.0);
+  for (const char* name :
+       {"left_shoulder", "right_shoulder", "left_hip", "right_hip"}) {
+    const int index = layout.IndexOf(name);
+    if (index >= 0) mask[index] = 1.0;
+  }
+  return mask;
+}
+
+// Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
+// them out).
+void BuildProblem(Stage stage, const Observations& obs,
+                  const KinematicModel& model, const KeypointLayout& layout,
+                  const FitOptions& options, double focal_prior_px,
+                  const ContactWeights* contacts, Parameters& params,
+                  ceres::Problem& problem) {
+  const int num_frames = obs.num_frames;
+  const int num_hinges = model.num_hinges();
+  const std::vector<double> torso = TorsoMask(layout);
+  const double sigma = options.reprojection_sigma;
+
+  // Per frame: robust reprojection of the confident keypoints (none on a
+  // frame without enough), the floor, uprightness.
+  for (int t = 0; t < num_frames; ++t) {
+    FrameCost cost;
+    cost.model = &model;
+    cost.cx_px = 0.5 * obs.width_px;
+    cost.cy_px = 0.5 * obs.height_px;
+    cost.inv_scale_px = 1.0 / obs.median_scale_px;
+    cost.sigma = sigma;
+    cost.ground_weight = options.ground_weight;
+    cost.penetration_weight = options.penetration_weight;
+    cost.upright_weight = options.upright_weight;
+    for (int j = 0; j < obs.num_keypoints; ++j) {
+      cost.observed_px.push_back(obs.Pixel(t, j));
+      cost.weights.push_back(obs.Weight(t, j) *
+                             (stage == Stage::kRoot ? torso[j] : 1.0));
+    }
+    problem.AddResidualBlock(
+        FrameCost::Create(std::move(cost)), nullptr,
+        {&params.focal_px, params.pitch_roll_rad, params.centre(t),
+         params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+         params.hinges_rad[t].data()});
+  }
+  // Temporal smoothness of the root and of its orientation.
+  for (int t = 1; t + 1 < num_frames; ++t) {
+    problem.AddResidualBlock(
+        AccelerationCost::Create(3, options.root_smooth_weight), nullptr,
+        {params.root_m[t - 1].data(), params.root_m[t].data(),
+         params.root_m[t + 1].data()});
+    problem.AddResidualBlock(
+        TurnAccelerationCost::Create(options.turn_smooth_weight), nullptr,
+        params.quaternion_wxyz[t - 1].data(), params.quaternion_wxyz[t].data(),
+        params.quaternion_wxyz[t + 1].data());
+  }
+  // The pose: prior toward rest, smooth in time, within the joint ranges;
+  // held at rest in stage 1.
+  for (int t = 0; t < num_frames; ++t) {
+    double* hinges = params.hinges_rad[t].data();
+    if (stage == Stage::kRoot) {
+      problem.SetParameterBlockConstant(hinges);
+      continue;
+    }
+    problem.AddResidualBlock(
+        PriorCost::Create(num_hinges, options.pose_prior_weight), nullptr,
+        {hinges});
+    if (t >= 1 && t + 1 < num_frames) {
+      problem.AddResidualBlock(
+          AccelerationCost::Create(num_hinges, options.pose_smooth_weight),
+          nullptr,
+          {params.hinges_rad[t - 1].data(), hinges,
+           params.hinges_rad[t + 1].data()});
+    }
+    for (int h = 0; h < num_hinges; ++h) {
+      problem.SetParameterLowerBound(hinges, h, model.hinge_low_rad[h]);
+      problem.SetParameterUpperBound(hinges, h, model.hinge_high_rad[h]);
+    }
+  }
+  // Feet that stay put while on the floor.
+  if (stage == Stage::kPoseWithContacts && contacts != nullptr) {
+    for (int t = 0; t + 1 < num_frames; ++t) {
+      FootSlideCost cost;
+      cost.model = &model;
+      bool any = false;
+      for (int s = 0; s < model.num_sole_points(); ++s) {
+        const double weight =
+            options.foot_slide_weight *
+            std::min((*contacts)[t][s], (*contacts)[t + 1][s]);
+        any = any || weight > 0;
+        cost.contact_weights.push_back(weight);
+      }
+      if (!any) continue;
+      problem.AddResidualBlock(
+          FootSlideCost::Create(std::move(cost)), nullptr,
+          {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+           params.hinges_rad[t].data(), params.root_m[t + 1].data(),
+           params.quaternion_wxyz[t + 1].data(),
+           params.hinges_rad[t + 1].data()});
+    }
+  }
+  // Orientation blocks live on the unit quaternions.
+  for (int t = 0; t < num_frames; ++t) {
+    problem.SetManifold(params.quaternion_wxyz[t].data(),
+                        new ceres::QuaternionManifold());
+  }
+  // The camera. Focal: fixed, or free with a prior at the image diagonal.
+  if (problem.HasParameterBlock(&params.focal_px)) {
+    if (options.fixed_focal_px > 0) {
+      problem.SetParameterBlockConstant(&params.focal_px);
+    } else {
+      problem.AddResidualBlock(
+          FocalPriorCost::Create(focal_prior_px, options.focal_prior_weight),
+          nullptr, &params.focal_px);
+      problem.SetParameterLowerBound(&params.focal_px, 0, 0.1 * focal_prior_px);
+      problem.SetParameterUpperBound(&params.focal_px, 0,
+                                     20.0 * focal_prior_px);
+    }
+    problem.SetParameterLowerBound(params.pitch_roll_rad, 0, -1.3);
+    problem.SetParameterUpperBound(params.pitch_roll_rad, 0, 1.3);
+    problem.SetParameterLowerBound(params.pitch_roll_rad, 1, -0.7);
+    problem.SetParameterUpperBound(params.pitch_roll_rad, 1, 0.7);
+  }
+  // Centre: the world's origin is below the first camera position, so its
+  // x and y are held (the world heading is the camera's yaw, likewise).
+  const int num_centres = static_cast<int>(params.centres_m.size());
+  for (int c = 0; c < num_centres; ++c) {
+    double* centre = params.centres_m[c].data();
+    if (!problem.HasParameterBlock(centre)) continue;
+    if (c == 0)
+      problem.SetManifold(centre, new ceres::SubsetManifold(3, {0, 1}));
+    problem.SetParameterLowerBound(centre, 2, 0.1);
+    // A person filming stands (or a tripod stands) about this high; spread
+    // over a moving camera's frames so its strength does not grow with
+    // the clip.
+    problem.AddResidualBlock(
+        LogPriorCost::CreateOnHeight(
+            options.camera_height_prior_m,
+            options.camera_height_prior_weight / std::sqrt(num_centres)),
+        nullptr, centre);
+  }
+  for (int c = 1; c < num_centres; ++c) {
+    problem.AddResidualBlock(VelocityCost::Create(options.camera_speed_weight),
+                             nullptr, params.centres_m[c - 1].data(),
+                             params.centres_m[c].data());
+    if (c + 1 < num_centres) {
+      problem.AddResidualBlock(
+          AccelerationCost::Create(3, options.camera_smooth_weight), nullptr,
+          {params.centres_m[c - 1].data(), params.centres_m[c].data(),
+           params.centres_m[c + 1].data()});
+    }
+  }
+}
+
+struct StageResult {
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;
+};
+
+StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
+                       const KinematicModel& model,
+                       const KeypointLayout& layout, const FitOptions& options,
+                       double focal_prior_px, const ContactWeights* contacts,
+                       Parameters& params) {
+  ceres::Problem problem;
+  BuildProblem(stage, obs, model, layout, options, focal_prior_px, contacts,
+               params, problem);
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = max_iterations;
+  solver.num_threads = options.num_threads;
+  solver.function_tolerance = options.function_tolerance;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  return {summary.initial_cost, summary.final_cost,
+          static_cast<int>(summary.iterations.size())};
+}
+
+// Mean pixel distance of frame t's confident keypoints from their
+// projection; -1 when the frame has none.
+double FrameResidualPx(const Observations& obs, const KinematicModel& model,
+                       Parameters& params, int t, double* weighted_sum,
+                       double* weight_total) {
+  std::vector<double> points(3 *
+                             (model.num_keypoints() + model.num_sole_points()));
+  CharacterPoints(model, params.root_m[t].data(),
+                  params.quaternion_wxyz[t].data(), params.hinges_rad[t].data(),
+                  points.data());
+  double sum = 0.0;
+  int count = 0;
+  for (int j = 0; j < obs.num_keypoints; ++j) {
+    const double weight = obs.Weight(t, j);
+    if (weight <= 0) continue;
+    double pixel[2];
+    FitProject(params.focal_px, params.pitch_roll_rad, params.centre(t),
+               &points[3 * j], 0.5 * obs.width_px, 0.5 * obs.height_px, pixel);
+    const double distance =
+        (Eigen::Vector2d(pixel[0], pixel[1]) - obs.Pixel(t, j)).norm();
+    sum += distance;
+    ++count;
+    *weighted_sum += weight * distance;
+    *weight_total += weight;
+  }
+  return count > 0 ? sum / count : -1.0;
+}
+
+// "focal 2203 px, pitch 9.8 deg, roll 0.1 deg, height 1.62 m" (the first
+// frame's centre for a moving camera), for progress lines.
+std::string DescribeCamera(Parameters& params) {
+  char text[128];
+  std::snprintf(text, sizeof(text),
+                "focal %.0f px, pitch %.1f deg, roll %.1f deg, height %.2f m",
+                params.focal_px, params.pitch_roll_rad[0] * 180.0 / M_PI,
+                params.pitch_roll_rad[1] * 180.0 / M_PI, params.centre(0)[2]);
+  return text;
+}
+
+}  // namespace
+
+bool ParseCameraMotion(const std::string& text, CameraMotion* motion) {
+  if (text == "static") {
+    *motion = CameraMotion::kStatic;
+  } else if (text == "moving") {
+    *motion = CameraMotion::kMoving;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* CameraMotionName(CameraMotion motion) {
+  return motion == CameraMotion::kMoving ? "moving" : "static";
+}
+
+void FitOptions::Validate() const {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw ConfigError(std::string("fit: ") + what);
+  };
+  require(fixed_focal_px >= 0 && std::isfinite(fixed_focal_px),
+          "focal length must be > 0 px (or 0 to estimate it)");
+  require(min_confidence >= 0 && min_confidence <= 1,
+          "min_confidence must be in [0, 1]");
+  require(reprojection_sigma > 0 && std::isfinite(reprojection_sigma),
+          "reprojection_sigma must be > 0");
+  for (double weight :
+       {pose_prior_weight, pose_smooth_weight, root_smooth_weight,
+        turn_smooth_weight, ground_weight, penetration_weight,
+        foot_slide_weight, camera_smooth_weight, camera_speed_weight,
+        upright_weight, camera_height_prior_weight, focal_prior_weight}) {
+    require(weight >= 0 && std::isfinite(weight),
+            "term weights must be finite and >= 0");
+  }
+  require(contact_height_m > 0 && std::isfinite(contact_height_m),
+          "contact_height_m must be > 0");
+  require(num_facing_starts >= 1 && num_facing_starts <= 16,
+          "num_facing_starts must be in [1, 16]");
+  require(screening_iterations >= 1 && root_stage_iterations >= 1 &&
+              pose_stage_iterations >= 1,
+          "stage iterations must be >= 1");
+  require(num_threads >= 1, "num_threads must be >= 1");
+  require(contact_rounds >= 1, "contact_rounds must be >= 1");
+  require(unconverged_residual_scale > 0,
+          "unconverged_residual_scale must be > 0");
+  require(min_frames >= 3, "min_frames must be >= 3");
+  require(min_keypoints_per_frame >= 4, "min_keypoints_per_frame must be >= 4");
+  require(min_person_scale_px > 0, "min_person_scale_px must be > 0");
+  require(min_usable_fraction > 0 && min_usable_fraction <= 1,
+          "min_usable_fraction must be in (0, 1]");
+}
+
+ViewEstimate FitView(const Clip2D& clip, const Character& character,
+                     const FitOptions& options, const std::string& source) {
+  // Outline: read the usable observations; stage 1 fits camera and root
+  // trajectory from several facing starts and keeps the lowest cost;
+  // stage 2 frees the pose; stage 3 adds non-sliding feet at the contacts
+  // stage 2 found; then report per-frame residuals and the frames that did
+  // not converge.
+  options.Validate();
+  const auto started = std::chrono::steady_clock::now();
+  const KinematicModel model = KinematicModel::FromCharacter(character);
+  if (clip.layout != &character.keypoint_layout()) {
+    throw InputError(source, "clip layout " + clip.layout->name +
+                                 " differs from the character's " +
+                                 character.keypoint_layout().name);
+  }
+  const Observations obs = ReadObservations(clip, options, source);
+  const RestPose rest = MakeRestPose(model, *clip.layout);
+  const double focal_prior_px =
+      options.fixed_focal_px > 0
+          ? options.fixed_focal_px
+          : std::hypot(static_cast<double>(obs.width_px), obs.height_px);
+  auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
+
+  FitSummary summary;
+  summary.camera_model = CameraMotionName(options.camera_motion);
+  summary.focal_fixed = options.fixed_focal_px > 0;
+  summary.num_frames = obs.num_frames;
+
+  // Stage 1, from each facing start: a short screening solve each, then
+  // the lowest-cost start runs to convergence. Yaw pi faces the camera
+  // (which looks along +x).
+  Parameters best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  double best_turn_deg = 0.0;
+  for (int k = 0; k < options.num_facing_starts; ++k) {
+    const double turn_deg = 360.0 * k / options.num_facing_starts;
+    Parameters params =
+        InitialParameters(obs, model, rest, options, focal_prior_px,
+                          M_PI + turn_deg * M_PI / 180.0);
+    StageResult result =
+        SolveStage(Stage::kRoot, options.screening_iterations, obs, model,
+                   *clip.layout, options, focal_prior_px, nullptr, params);
+    summary.iterations += result.iterations;
+    char line[160];
+    std::snprintf(line, sizeof(line),
+                  "stage 1 (camera + root), start %d/%d (turned %.0f deg from "
+                  "facing the camera): cost %.4g -> %.4g",
+                  k + 1, options.num_facing_starts, turn_deg,
+                  result.initial_cost, result.final_cost);
+    say(line);
+    if (k == 0) summary.initial_cost = result.initial_cost;
+    if (result.final_cost < best_cost) {
+      best = std::move(params);
+      best_cost = result.final_cost;
+      best_turn_deg = turn_deg;
+    }
+  }
+  char label[64];
+  std::snprintf(label, sizeof(label), "turned %.0f deg from facing the camera",
+                best_turn_deg);
+  summary.initialization = label;
+  StageResult root =
+      SolveStage(Stage::kRoot, options.root_stage_iterations, obs, model,
+                 *clip.layout, options, focal_prior_px, nullptr, best);
+  summary.iterations += root.iterations;
+  say("stage 1 (camera + root): cost " + std::to_string(root.final_cost) +
+      "; " + DescribeCamera(best));
+
+  // Stage 2: the full pose.
+  StageResult pose =
+      SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
+                 *clip.layout, options, focal_prior_px, nullptr, best);
+  summary.iterations += pose.iterations;
+  say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
+      " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
+
+  // Stage 3: feet that do not slide, at the contacts the previous solve
+  // found; relabelled and solved again, since better contacts move the root
+  // and the root's motion sharpens the contacts.
+  StageResult final_stage;
+  for (int round = 0; round < options.contact_rounds; ++round) {
+    const ContactWeights contacts = EstimateContacts(best, model, options);
+    if (options.camera_motion == CameraMotion::kMoving)
+      RemoveContactSlide(model, contacts, best);
+    final_stage = SolveStage(
+        Stage::kPoseWithContacts, options.pose_stage_iterations, obs, model,
+        *clip.layout, options, focal_prior_px, &contacts, best);
+    summary.iterations += final_stage.iterations;
+    say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
+        std::to_string(final_stage.initial_cost) + " -> " +
+        std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best));
+  }
+  summary.final_cost = final_stage.final_cost;
+
+  // The estimate and its account.
+  ViewEstimate estimate;
+  estimate.skeleton_name = model.skeleton_name;
+  for (size_t c = 0; c < best.centres_m.size(); ++c) {
+    estimate.cameras.push_back(
+        ToPinholeCamera(best.focal_px, best.pitch_roll_rad,
+                        best.centres_m[c].data(), obs.width_px, obs.height_px));
+  }
+  double weighted_sum = 0.0, weight_total = 0.0;
+  const double unconverged_px =
+      options.unconverged_residual_scale * obs.median_scale_px;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    estimate.poses.push_back(FittedPose(character, best.root_m[t].data(),
+                                        best.quaternion_wxyz[t].data(),
+                                        best.hinges_rad[t].data()));
+    const double residual =
+        FrameResidualPx(obs, model, best, t, &weighted_sum, &weight_total);
+    estimate.residual_px.push_back(residual);
+    if (!obs.usable[t] || residual > unconverged_px)
+      summary.unconverged_frames.push_back(t);
+  }
+  summary.mean_reprojection_px =
+      weight_total > 0 ? weighted_sum / weight_total : 0.0;
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
+          .count();
+  estimate.summary = summary;
+  return estimate;
+}
+
+ReferenceBundle FitBundle(
+    const ReferenceBundle& bundle, const Character& character,
+    const FitOptions& options, const std::string& source,
+    const std::function<void(int view, const ViewEstimate&)>& progress) {
+  ReferenceBundle out = bundle;
+  std::vector<ViewEstimate> estimates;
+  for (size_t v = 0; v < bundle.views.size(); ++v) {
+    estimates.push_back(
+        FitView(bundle.views[v].clip, character, options,
+                source + " (view " + bundle.views[v].name + ")"));
+    if (progress) progress(static_cast<int>(v), estimates.back());
+  }
+  out.estimate = std::move(estimates);
+  return out;
+}
+
+}  // namespace m2d

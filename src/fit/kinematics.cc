@@ -1,0 +1,125 @@
+#include "fit/kinematics.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+
+#include "common/error.h"
+#include "sim/character.h"
+#include "sim/pose_mapping.h"
+
+namespace m2d {
+namespace {
+
+// The four lowest corners (in the body frame) of every box geom of `body`.
+std::vector<Eigen::Vector3d> SoleCorners(const mjModel* model, int body) {
+  std::vector<Eigen::Vector3d> corners;
+  for (int g = 0; g < model->ngeom; ++g) {
+    if (model->geom_bodyid[g] != body || model->geom_type[g] != mjGEOM_BOX)
+      continue;
+    const Eigen::Vector3d centre(model->geom_pos + 3 * g);
+    const mjtNum* q = model->geom_quat + 4 * g;
+    const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
+    const Eigen::Vector3d size(model->geom_size + 3 * g);
+    std::vector<Eigen::Vector3d> box;
+    for (int sx : {-1, 1})
+      for (int sy : {-1, 1})
+        for (int sz : {-1, 1}) {
+          box.push_back(centre + rotation * Eigen::Vector3d(sx * size.x(),
+                                                            sy * size.y(),
+                                                            sz * size.z()));
+        }
+    std::sort(box.begin(), box.end(),
+              [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+                return a.z() < b.z();
+              });
+    corners.insert(corners.end(), box.begin(), box.begin() + 4);
+  }
+  return corners;
+}
+
+}  // namespace
+
+KinematicModel KinematicModel::FromCharacter(const Character& character) {
+  const Skeleton& skeleton = character.skeleton();
+  const mjModel* mj_model = character.model();
+  KinematicModel model;
+  model.skeleton_name = skeleton.name;
+  if (skeleton.num_joints() > 64) {
+    throw InputError(character.config().source_path,
+                     "the fit handles skeletons of up to 64 joints");
+  }
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    const SkeletonJoint& source = skeleton.joints[j];
+    const BoundJoint& bound = character.joints()[j];
+    Joint joint;
+    joint.parent = source.parent;
+    joint.type = bound.type;
+    joint.offset_m = source.offset_m;
+    joint.axis = source.axis;
+    joint.first_hinge = bound.first_hinge;
+    joint.revolute_sign = bound.revolute_sign;
+    model.joints.push_back(joint);
+  }
+  for (const KeypointAnchor& anchor : character.keypoint_map().anchors)
+    model.keypoints.push_back({anchor.joint, anchor.offset_m});
+  for (const ActuatedHinge& hinge : character.hinges()) {
+    model.hinge_low_rad.push_back(hinge.range_low_rad);
+    model.hinge_high_rad.push_back(hinge.range_high_rad);
+  }
+  // Sole points: a ground-contact body is the body of some skeleton joint;
+  // its box geoms' lowest corners are where it meets the floor.
+  for (int body : character.ground_contact_bodies()) {
+    int joint = -1;
+    for (int j = 0; j < skeleton.num_joints(); ++j) {
+      if (character.joints()[j].body_id == body) joint = j;
+    }
+    if (joint < 0) continue;
+    const std::vector<Eigen::Vector3d> corners = SoleCorners(mj_model, body);
+    for (const Eigen::Vector3d& corner : corners) {
+      model.sole_points.push_back({joint, corner});
+      model.sole_foot.push_back(model.num_feet);
+    }
+    if (!corners.empty()) ++model.num_feet;
+  }
+  if (model.num_keypoints() + model.num_sole_points() > 128) {
+    throw InputError(character.config().source_path,
+                     "the fit handles up to 128 keypoints and sole points");
+  }
+  if (model.num_feet == 0) {
+    throw InputError(character.config().source_path,
+                     "no ground-contact body has a box geom: the fit needs "
+                     "the soles to put the character on the floor");
+  }
+  // Standing height: the rest pose with its root at z = 0 has its lowest
+  // sole point at -height.
+  const double origin[3] = {0, 0, 0};
+  const double identity[4] = {1, 0, 0, 0};
+  std::vector<double> zeros(model.num_hinges(), 0.0);
+  std::vector<double> points(3 *
+                             (model.num_keypoints() + model.num_sole_points()));
+  CharacterPoints(model, origin, identity, zeros.data(), points.data());
+  double lowest_m = 0.0;
+  for (int s = 0; s < model.num_sole_points(); ++s) {
+    lowest_m = std::min(lowest_m, points[3 * (model.num_keypoints() + s) + 2]);
+  }
+  model.standing_root_height_m = -lowest_m;
+  return model;
+}
+
+Pose3D FittedPose(const Character& character, const double* root_position_m,
+                  const double* root_quaternion_wxyz,
+                  const double* hinges_rad) {
+  const mjModel* model = character.model();
+  std::vector<double> qpos(model->qpos0, model->qpos0 + model->nq);
+  double* root = qpos.data() + character.root_qpos_address();
+  Eigen::Vector4d q(root_quaternion_wxyz[0], root_quaternion_wxyz[1],
+                    root_quaternion_wxyz[2], root_quaternion_wxyz[3]);
+  q.normalize();
+  for (int k = 0; k < 3; ++k) root[k] = root_position_m[k];
+  for (int k = 0; k < 4; ++k) root[3 + k] = q[k];
+  for (size_t h = 0; h < character.hinges().size(); ++h)
+    qpos[character.hinges()[h].qpos_address] = hinges_rad[h];
+  return QposToPose(character, qpos.data());
+}
+
+}  // namespace m2d

@@ -1,0 +1,172 @@
+// fit: estimating cameras and 3D poses from 2D keypoints alone (an
+// SMPLify-like fit with Ceres), the first stage of learning from video.
+//
+// This header: the character's forward kinematics, written once as templated
+// code so that Ceres' Jets flow through it. The pose is parameterized exactly
+// as MuJoCo's qpos is (root position, root quaternion, hinge angles), so
+// joint limits are the MJCF hinge ranges and a fitted pose maps onto the
+// simulated character without conversion.
+#ifndef MIMIC2D_FIT_KINEMATICS_H_
+#define MIMIC2D_FIT_KINEMATICS_H_
+
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "motion/motion3d.h"
+#include "motion/skeleton.h"
+
+namespace m2d {
+
+class Character;
+
+// A point fixed in one joint's frame (a keypoint or a sole corner).
+struct BodyPoint {
+  int joint = 0;
+  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
+};
+
+// The character's kinematic tree as plain data, read once from a Character.
+struct KinematicModel {
+  struct Joint {
+    int parent = -1;
+    JointType type = JointType::kFixed;
+    Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();  // in parent frame
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitY();     // revolute only
+    int first_hinge = -1;        // index into the hinge angles; -1: none
+    double revolute_sign = 1.0;  // MJCF angle = sign x angle about axis
+  };
+  std::string skeleton_name;
+  std::vector<Joint> joints;           // parents precede children
+  std::vector<BodyPoint> keypoints;    // in keypoint-layout order
+  std::vector<BodyPoint> sole_points;  // contact bodies' lowest box corners
+  std::vector<int> sole_foot;          // per sole point: 0 or 1, which foot
+  int num_feet = 0;
+  std::vector<double> hinge_low_rad;  // MJCF ranges, in action order
+  std::vector<double> hinge_high_rad;
+  double standing_root_height_m = 0.0;  // root z with soles on the floor
+
+  int num_hinges() const { return static_cast<int>(hinge_low_rad.size()); }
+  int num_keypoints() const { return static_cast<int>(keypoints.size()); }
+  int num_sole_points() const { return static_cast<int>(sole_points.size()); }
+
+  // Reads the skeleton, keypoint sites, hinge ranges and the sole corners of
+  // the ground-contact bodies' boxes from a loaded character.
+  static KinematicModel FromCharacter(const Character& character);
+};
+
+// Parameters of one frame's pose, MuJoCo's layout: root position (3), root
+// quaternion (w, x, y, z; any norm, normalized here), hinge angles.
+inline constexpr int kRootPositionSize = 3;
+inline constexpr int kRootQuaternionSize = 4;
+
+namespace fk_internal {
+
+template <typename T>
+using Matrix3 = Eigen::Matrix<T, 3, 3>;
+template <typename T>
+using Vector3 = Eigen::Matrix<T, 3, 1>;
+
+// Rotation by `angle` about the unit axis `axis` (Rodrigues; K and K^2
+// are constants, so only two scalars carry derivatives).
+template <typename T>
+Matrix3<T> AxisRotation(const Eigen::Vector3d& axis, const T& angle) {
+  using std::cos;
+  using std::sin;
+  Eigen::Matrix3d k;
+  k << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+  const Eigen::Matrix3d k2 = k * k;
+  const T s = sin(angle), one_minus_c = T(1) - cos(angle);
+  Matrix3<T> rotation;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      rotation(r, c) =
+          T(r == c ? 1.0 : 0.0) + s * k(r, c) + one_minus_c * k2(r, c);
+  return rotation;
+}
+
+// Rx(a) Ry(b) Rz(c) in closed form (MuJoCo's x, y, z hinge chain).
+template <typename T>
+Matrix3<T> IntrinsicXyzRotation(const T* angles) {
+  using std::cos;
+  using std::sin;
+  const T ca = cos(angles[0]), sa = sin(angles[0]);
+  const T cb = cos(angles[1]), sb = sin(angles[1]);
+  const T cc = cos(angles[2]), sc = sin(angles[2]);
+  Matrix3<T> rotation;
+  rotation(0, 0) = cb * cc;
+  rotation(0, 1) = -cb * sc;
+  rotation(0, 2) = sb;
+  rotation(1, 0) = ca * sc + sa * sb * cc;
+  rotation(1, 1) = ca * cc - sa * sb * sc;
+  rotation(1, 2) = -sa * cb;
+  rotation(2, 0) = sa * sc - ca * sb * cc;
+  rotation(2, 1) = sa * cc + ca * sb * sc;
+  rotation(2, 2) = ca * cb;
+  return rotation;
+}
+
+}  // namespace fk_internal
+
+// World positions of the model's keypoints then its sole points, 3 numbers
+// each, into `points_m` (size 3 x (keypoints + sole points)).
+template <typename T>
+void CharacterPoints(const KinematicModel& model, const T* root_position_m,
+                     const T* root_quaternion_wxyz, const T* hinges_rad,
+                     T* points_m) {
+  using fk_internal::AxisRotation;
+  using Matrix3 = fk_internal::Matrix3<T>;
+  using Vector3 = fk_internal::Vector3<T>;
+  // Outline: compose each joint's world frame from its parent's (parents
+  // come first), then place the body points in their joints' frames.
+  const int num_joints = static_cast<int>(model.joints.size());
+  constexpr int kMaxJoints = 64;  // FromCharacter checks the count
+  Matrix3 orientation[kMaxJoints];
+  Vector3 position[kMaxJoints];
+  for (int j = 0; j < num_joints; ++j) {
+    const KinematicModel::Joint& joint = model.joints[j];
+    Matrix3 local = Matrix3::Identity();
+    if (joint.type == JointType::kFree) {
+      T rotation_row_major[9];
+      ceres::QuaternionToRotation(root_quaternion_wxyz, rotation_row_major);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) local(r, c) = rotation_row_major[3 * r + c];
+    } else if (joint.type == JointType::kSpherical) {
+      local = fk_internal::IntrinsicXyzRotation(hinges_rad + joint.first_hinge);
+    } else if (joint.type == JointType::kRevolute) {
+      local = AxisRotation<T>(
+          joint.axis, T(joint.revolute_sign) * hinges_rad[joint.first_hinge]);
+    }
+    const Vector3 offset = joint.offset_m.cast<T>();
+    if (joint.parent < 0) {
+      position[j] =
+          Vector3(root_position_m[0], root_position_m[1], root_position_m[2]) +
+          offset;
+      orientation[j] = local;
+    } else {
+      position[j] = position[joint.parent] + orientation[joint.parent] * offset;
+      orientation[j] = orientation[joint.parent] * local;
+    }
+  }
+  int out = 0;
+  for (const std::vector<BodyPoint>* points :
+       {&model.keypoints, &model.sole_points}) {
+    for (const BodyPoint& point : *points) {
+      const Vector3 world = position[point.joint] +
+                            orientation[point.joint] * point.offset_m.cast<T>();
+      for (int k = 0; k < 3; ++k) points_m[out++] = world[k];
+    }
+  }
+}
+
+// A fitted frame as the skeleton's Pose3D (the mapping the simulation uses,
+// sim/pose_mapping.h's QposToPose, so the two cannot disagree).
+Pose3D FittedPose(const Character& character, const double* root_position_m,
+                  const double* root_quaternion_wxyz, const double* hinges_rad);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_FIT_KINEMATICS_H_

@@ -1,0 +1,100 @@
+// End-to-end checks of `mimic2d bench fit`: the quick table runs a real fit
+// and prints a row of finite figures and a JSON file; a bad clip name is a
+// named error.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "common/file_io.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+struct BenchResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+BenchResult RunMimic2d(const std::string& arguments) {
+  const std::string command =
+      std::string(MIMIC2D_BINARY) + " " + arguments + " 2>&1";
+  BenchResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (fgets(buffer, sizeof(buffer), pipe) != nullptr)
+    result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// The table line that starts with `prefix`, or "".
+std::string LineStartingWith(const std::string& text,
+                             const std::string& prefix) {
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.compare(0, prefix.size(), prefix) == 0) return line;
+  }
+  return "";
+}
+
+TEST(CliBenchFit, QuickPrintsARowOfFiniteFigures) {
+  const std::string dir = testing::TempDir("cli_bench_fit");
+  const std::string json_path = dir + "/table.json";
+  const BenchResult result = RunMimic2d("bench fit --quick -o " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("[1/1] walk, setting A, clean, view 1/1"),
+            std::string::npos)
+      << result.output;
+  // "walk A clean 1/1 <frames> <9 figures>"
+  const std::string row = LineStartingWith(result.output, "walk ");
+  ASSERT_FALSE(row.empty()) << result.output;
+  std::istringstream fields(row);
+  std::string clip, setting, noise, fits;
+  int frames = 0;
+  fields >> clip >> setting >> noise >> fits >> frames;
+  EXPECT_EQ(setting, "A");
+  EXPECT_EQ(noise, "clean");
+  EXPECT_EQ(fits, "1/1");
+  EXPECT_GT(frames, 30);
+  int figures = 0;
+  std::string field;
+  while (fields >> field) {
+    const double value = std::stod(field);
+    EXPECT_TRUE(std::isfinite(value)) << row;
+    EXPECT_GE(value, 0.0) << row;
+    ++figures;
+  }
+  EXPECT_EQ(figures, 9) << row;
+  EXPECT_FALSE(LineStartingWith(result.output, "all ").empty())
+      << result.output;
+
+  const nlohmann::json json = ReadJsonFile(json_path);
+  EXPECT_EQ(json["format"], "mimic2d.bench_fit");
+  ASSERT_EQ(json["rows"].size(), 1u);
+  const nlohmann::json& mean = json["rows"][0]["mean"];
+  for (const char* key :
+       {"focal_error_pct", "pitch_error_deg", "roll_error_deg",
+        "root_relative_mpjpe_mm", "pa_mpjpe_mm", "mean_reprojection_px",
+        "seconds_per_100_frames", "cpu_seconds_per_100_frames"}) {
+    ASSERT_TRUE(mean.contains(key)) << key;
+    EXPECT_TRUE(std::isfinite(mean[key].get<double>())) << key;
+  }
+}
+
+TEST(CliBenchFit, AnUnknownClipIsNamed) {
+  const BenchResult result = RunMimic2d("bench fit --clips walk,moonwalk");
+  EXPECT_NE(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("moonwalk"), std::string::npos) << result.output;
+  // Rejected before any fit runs.
+  EXPECT_EQ(result.output.find("[1/"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace m2d

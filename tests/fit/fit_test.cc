@@ -1,0 +1,417 @@
+// tests: the fit — forward kinematics against MuJoCo, each cost term's
+// derivatives against finite differences, recovery of a known camera and
+// poses from a synthetic clip, and named errors for input it cannot use.
+#include "fit/fit.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "common/error.h"
+#include "fit/camera_model.h"
+#include "fit/costs.h"
+#include "fit/kinematics.h"
+#include "motion/bundle.h"
+#include "motion/motion_io.h"
+#include "sim/simulation.h"
+#include "test_paths.h"
+
+namespace m2d {
+namespace {
+
+using testing::SourcePath;
+
+std::shared_ptr<const Character> Humanoid() {
+  static std::shared_ptr<const Character> character =
+      LoadCharacterForSimulation(SourcePath("assets/characters/humanoid.yaml"),
+                                 "flat", SimulationOptions());
+  return character;
+}
+
+// Random hinge angles within their ranges and a random root.
+struct RandomPose {
+  Eigen::Vector3d root_m;
+  Eigen::Vector4d quaternion_wxyz;
+  std::vector<double> hinges_rad;
+};
+
+RandomPose MakeRandomPose(const KinematicModel& model, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  RandomPose pose;
+  pose.root_m =
+      Eigen::Vector3d(unit(rng) * 4 - 2, unit(rng) * 4 - 2, 0.5 + unit(rng));
+  Eigen::Quaterniond q = Eigen::Quaterniond::UnitRandom();
+  pose.quaternion_wxyz = Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
+  for (int h = 0; h < model.num_hinges(); ++h) {
+    pose.hinges_rad.push_back(
+        model.hinge_low_rad[h] +
+        unit(rng) * (model.hinge_high_rad[h] - model.hinge_low_rad[h]));
+  }
+  return pose;
+}
+
+TEST(FitKinematics, MatchesMujocoKeypointsAndSoles) {
+  auto character = Humanoid();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  ASSERT_EQ(model.num_keypoints(), 17);
+  ASSERT_EQ(model.num_feet, 2);
+  ASSERT_EQ(model.num_sole_points(), 8);
+  Simulation simulation(character, SimulationOptions());
+  std::mt19937_64 rng(7);
+  double worst_m = 0.0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomPose pose = MakeRandomPose(model, rng);
+    simulation.Reset();
+    simulation.SetPose(FittedPose(*character, pose.root_m.data(),
+                                  pose.quaternion_wxyz.data(),
+                                  pose.hinges_rad.data()));
+    std::vector<double> points(3 * (17 + 8));
+    CharacterPoints(model, pose.root_m.data(), pose.quaternion_wxyz.data(),
+                    pose.hinges_rad.data(), points.data());
+    const mjData* data = simulation.data();
+    const mjModel* mj = character->model();
+    // Keypoints: MuJoCo's sites.
+    for (int j = 0; j < 17; ++j) {
+      const int site = character->keypoint_sites()[j];
+      for (int k = 0; k < 3; ++k) {
+        worst_m = std::max(worst_m, std::abs(points[3 * j + k] -
+                                             data->site_xpos[3 * site + k]));
+      }
+    }
+    // Soles: the lowest point of each foot box in MuJoCo is one of ours.
+    for (int foot = 0; foot < 2; ++foot) {
+      const int body = character->ground_contact_bodies()[foot];
+      for (int g = 0; g < mj->ngeom; ++g) {
+        if (mj->geom_bodyid[g] != body) continue;
+        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>
+            rotation(data->geom_xmat + 9 * g);
+        const Eigen::Vector3d centre(data->geom_xpos + 3 * g);
+        const Eigen::Vector3d size(mj->geom_size + 3 * g);
+        double lowest = 1e9;
+        for (int sx : {-1, 1})
+          for (int sy : {-1, 1})
+            for (int sz : {-1, 1}) {
+              lowest = std::min(
+                  lowest, (centre + rotation * Eigen::Vector3d(sx * size.x(),
+                                                               sy * size.y(),
+                                                               sz * size.z()))
+                              .z());
+            }
+        double ours = 1e9;
+        for (int s = 0; s < 8; ++s) {
+          if (model.sole_foot[s] == foot)
+            ours = std::min(ours, points[3 * (17 + s) + 2]);
+        }
+        // Our soles are the box's 4 lowest corners in the foot frame: the
+        // lowest world corner is among them unless the foot is upside down.
+        EXPECT_LE(ours, lowest + 0.2);
+        EXPECT_GE(ours, lowest - 1e-9);
+      }
+    }
+  }
+  EXPECT_LT(worst_m, 1e-9);
+  EXPECT_NEAR(model.standing_root_height_m, 0.881416, 1e-6);
+}
+
+TEST(FitCamera, PitchAndRollRoundTripThroughAPinholeCamera) {
+  const double pitch_roll[2] = {0.3, -0.1};
+  const double centre[3] = {1, 2, 1.5};
+  const PinholeCamera camera =
+      ToPinholeCamera(1200, pitch_roll, centre, 1920, 1080);
+  const Eigen::Vector2d recovered = CameraPitchRollRad(camera);
+  EXPECT_NEAR(recovered[0], 0.3, 1e-12);
+  EXPECT_NEAR(recovered[1], -0.1, 1e-12);
+  EXPECT_TRUE(camera.CenterWorld().isApprox(Eigen::Vector3d(1, 2, 1.5)));
+  // FitProject and PinholeCamera::Project agree.
+  const double point[3] = {5, 1, 0.7};
+  double pixel[2];
+  FitProject(1200.0, pitch_roll, centre, point, 960, 540, pixel);
+  const Projection projection = camera.Project({5, 1, 0.7});
+  EXPECT_NEAR(pixel[0], projection.pixel_px.x(), 1e-9);
+  EXPECT_NEAR(pixel[1], projection.pixel_px.y(), 1e-9);
+  // A level camera sees a point straight ahead at the principal point, a
+  // camera pitched down sees it above the centre.
+  const double level[2] = {0, 0};
+  const double ahead[3] = {6, 2, 1.5};
+  FitProject(1200.0, level, centre, ahead, 960, 540, pixel);
+  EXPECT_NEAR(pixel[0], 960, 1e-9);
+  EXPECT_NEAR(pixel[1], 540, 1e-9);
+  FitProject(1200.0, pitch_roll, centre, ahead, 960, 540, pixel);
+  EXPECT_LT(pixel[1], 540);
+}
+
+// Checks a cost's Jacobians against central differences at `blocks`.
+void ExpectGradientsMatch(ceres::CostFunction* cost,
+                          std::vector<double*> blocks,
+                          const std::vector<const ceres::Manifold*>& manifolds,
+                          const char* name) {
+  std::unique_ptr<ceres::CostFunction> owned(cost);
+  ceres::NumericDiffOptions numeric;
+  numeric.ridders_relative_initial_step_size = 1e-4;
+  ceres::GradientChecker checker(cost, &manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(blocks.data(), 1e-4, &results))
+      << name << ": " << results.error_log;
+}
+
+TEST(FitCosts, EveryTermsJacobianMatchesFiniteDifferences) {
+  auto character = Humanoid();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  std::mt19937_64 rng(3);
+  RandomPose a = MakeRandomPose(model, rng), b = MakeRandomPose(model, rng),
+             c = MakeRandomPose(model, rng);
+  // Feet near the floor so that ground and penetration terms are active.
+  a.root_m.z() = b.root_m.z() = 0.6;
+  double focal = 1100.0;
+  double pitch_roll[2] = {0.2, 0.05};
+  double centre[3] = {-4.0, 0.5, 1.6};
+  const ceres::Manifold* none = nullptr;
+
+  FrameCost frame;
+  frame.model = &model;
+  frame.cx_px = 960;
+  frame.cy_px = 540;
+  frame.inv_scale_px = 1.0 / 120.0;
+  frame.sigma = 0.5;
+  frame.ground_weight = 10.0;
+  frame.penetration_weight = 100.0;
+  frame.upright_weight = 0.5;
+  for (int j = 0; j < 17; ++j) {
+    frame.observed_px.emplace_back(900 + 10 * j, 500 - 7 * j);
+    frame.weights.push_back(j % 5 == 0 ? 0.0 : 0.9);
+  }
+  ExpectGradientsMatch(FrameCost::Create(frame),
+                       {&focal, pitch_roll, centre, a.root_m.data(),
+                        a.quaternion_wxyz.data(), a.hinges_rad.data()},
+                       {none, none, none, none, none, none}, "frame");
+  // Upright and with soles below the floor: penetration active.
+  RandomPose standing = a;
+  standing.quaternion_wxyz = Eigen::Vector4d(0.99, 0.05, -0.08, 0.1);
+  standing.root_m.z() = 0.8;
+  ExpectGradientsMatch(
+      FrameCost::Create(frame),
+      {&focal, pitch_roll, centre, standing.root_m.data(),
+       standing.quaternion_wxyz.data(), standing.hinges_rad.data()},
+      {none, none, none, none, none, none}, "frame on the floor");
+  FootSlideCost slide;
+  slide.model = &model;
+  slide.contact_weights.assign(8, 0.0);
+  slide.contact_weights[1] = 30.0;
+  slide.contact_weights[6] = 12.0;
+  ExpectGradientsMatch(
+      FootSlideCost::Create(slide),
+      {a.root_m.data(), a.quaternion_wxyz.data(), a.hinges_rad.data(),
+       b.root_m.data(), b.quaternion_wxyz.data(), b.hinges_rad.data()},
+      {none, none, none, none, none, none}, "foot slide");
+  ExpectGradientsMatch(PriorCost::Create(model.num_hinges(), 0.05),
+                       {a.hinges_rad.data()}, {none}, "pose prior");
+  ExpectGradientsMatch(
+      AccelerationCost::Create(model.num_hinges(), 4.0),
+      {a.hinges_rad.data(), b.hinges_rad.data(), c.hinges_rad.data()},
+      {none, none, none}, "pose acceleration");
+  ExpectGradientsMatch(TurnAccelerationCost::Create(8.0),
+                       {a.quaternion_wxyz.data(), b.quaternion_wxyz.data(),
+                        c.quaternion_wxyz.data()},
+                       {none, none, none}, "turn acceleration");
+  ExpectGradientsMatch(VelocityCost::Create(0.5),
+                       {a.root_m.data(), b.root_m.data()}, {none, none},
+                       "camera speed");
+  ExpectGradientsMatch(FocalPriorCost::Create(2203.0, 2.0), {&focal}, {none},
+                       "focal prior");
+}
+
+// A bundle of the walk seen by cameras at known places.
+ReferenceBundle SyntheticWalk(const Character& character, int num_views,
+                              double duration_s, CameraFollow follow) {
+  const Motion3D motion = ReadDeepMimicMotion(
+      SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt"),
+      character.shared_skeleton());
+  BundleFromMotionOptions options;
+  options.duration_s = duration_s;
+  options.follow = follow;
+  options.rig.num_views = num_views;
+  options.rig.elevation_deg = 15.0;
+  return MakeBundleFromMotion(motion, character.keypoint_map(), options,
+                              "walk");
+}
+
+// Mean over frames of the root-relative keypoint error after the best
+// rotation about z for the whole clip (the fit's heading is its own).
+double YawAlignedRootRelativeErrorM(const std::vector<Pose3D>& fitted,
+                                    const GroundTruth3D& truth,
+                                    const Character& character) {
+  const KeypointLayout& layout = character.keypoint_layout();
+  std::vector<std::vector<Eigen::Vector3d>> ours, theirs;
+  for (size_t t = 0; t < fitted.size(); ++t) {
+    std::vector<Eigen::Vector3d> points = KeypointPositions(
+        character.skeleton(), character.keypoint_map(), fitted[t]);
+    std::vector<Eigen::Vector3d> true_points = truth.keypoints_m[t];
+    Eigen::Vector3d root = Eigen::Vector3d::Zero(),
+                    true_root = Eigen::Vector3d::Zero();
+    for (int index : layout.root_keypoints) {
+      root += points[index] / layout.root_keypoints.size();
+      true_root += true_points[index] / layout.root_keypoints.size();
+    }
+    for (auto& p : points) p -= root;
+    for (auto& p : true_points) p -= true_root;
+    ours.push_back(points);
+    theirs.push_back(true_points);
+  }
+  double cross = 0, dot = 0;
+  for (size_t t = 0; t < ours.size(); ++t)
+    for (size_t j = 0; j < ours[t].size(); ++j) {
+      dot +=
+          ours[t][j].x() * theirs[t][j].x() + ours[t][j].y() * theirs[t][j].y();
+      cross +=
+          ours[t][j].x() * theirs[t][j].y() - ours[t][j].y() * theirs[t][j].x();
+    }
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(std::atan2(cross, dot), Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  double sum = 0;
+  int count = 0;
+  for (size_t t = 0; t < ours.size(); ++t)
+    for (size_t j = 0; j < ours[t].size(); ++j) {
+      sum += (turn * ours[t][j] - theirs[t][j]).norm();
+      ++count;
+    }
+  return sum / count;
+}
+
+TEST(Fit, RecoversAKnownStaticCameraAndThePoses) {
+  auto character = Humanoid();
+  ReferenceBundle bundle =
+      SyntheticWalk(*character, 2, 2.0, CameraFollow::kStatic);
+  // The focal length is known here (`mimic2d fit --focal`): a person alone
+  // barely determines it (docs/fit.md), and pitch trades off against it.
+  FitOptions options;
+  options.fixed_focal_px = bundle.views[0].cameras[0].intrinsics().fx_px;
+  options.progress = [](const std::string& line) {
+    std::printf("  %s\n", line.c_str());
+  };
+  for (size_t v = 0; v < bundle.views.size(); ++v) {
+    const ViewEstimate estimate =
+        FitView(bundle.views[v].clip, *character, options, "walk");
+    const PinholeCamera& truth = bundle.views[v].cameras[0];
+    const Eigen::Vector2d true_angles = CameraPitchRollRad(truth);
+    const Eigen::Vector2d angles = CameraPitchRollRad(estimate.cameras[0]);
+    const double error_m = YawAlignedRootRelativeErrorM(
+        estimate.poses, *bundle.ground_truth, *character);
+    std::printf(
+        "%s\nview %zu: focal %.0f (true %.0f), pitch %.2f (%.2f) deg, "
+        "roll %.2f (%.2f) deg, height %.2f (%.2f) m, root-relative "
+        "%.0f mm\n",
+        estimate.summary.BriefReport().c_str(), v,
+        estimate.cameras[0].intrinsics().fx_px, truth.intrinsics().fx_px,
+        angles[0] * 180 / M_PI, true_angles[0] * 180 / M_PI,
+        angles[1] * 180 / M_PI, true_angles[1] * 180 / M_PI,
+        estimate.cameras[0].CenterWorld().z(), truth.CenterWorld().z(),
+        error_m * 1000);
+    EXPECT_NEAR(angles[0], true_angles[0], 5 * M_PI / 180);
+    EXPECT_NEAR(angles[1], true_angles[1], 5 * M_PI / 180);
+    EXPECT_LT(estimate.summary.mean_reprojection_px, 8.0);
+    EXPECT_LT(error_m, 0.08);
+  }
+}
+
+// Input the fit cannot use is a named error, never a silent estimate.
+TEST(Fit, RejectsInputItCannotUseWithANamedError) {
+  auto character = Humanoid();
+  const ReferenceBundle bundle =
+      SyntheticWalk(*character, 1, 1.0, CameraFollow::kStatic);
+  const Clip2D& good = bundle.views[0].clip;
+  FitOptions options;
+  auto expect_error = [&](const Clip2D& clip, const std::string& needle) {
+    try {
+      FitView(clip, *character, options, "clip.json");
+      ADD_FAILURE() << "no error; expected one mentioning '" << needle << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("clip.json"), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos)
+          << e.what();
+    }
+  };
+  // Too short.
+  Clip2D short_clip = good;
+  short_clip.keypoints = KeypointTrack(4, 17);
+  for (int t = 0; t < 4; ++t)
+    for (int j = 0; j < 17; ++j)
+      short_clip.keypoints.at(t, j) = good.keypoints.at(t, j);
+  expect_error(short_clip, "frames");
+  // A person a few pixels tall: shrink about the image centre.
+  Clip2D tiny = good;
+  for (int t = 0; t < tiny.num_frames(); ++t)
+    for (int j = 0; j < 17; ++j) {
+      Keypoint2D& p = tiny.keypoints.at(t, j);
+      p.x_px = 960 + (p.x_px - 960) * 0.02;
+      p.y_px = 540 + (p.y_px - 540) * 0.02;
+    }
+  expect_error(tiny, "px in size");
+  // A coordinate far outside the image.
+  Clip2D outside = good;
+  outside.keypoints.at(3, 9).x_px = 1e6;
+  expect_error(outside, "far outside");
+  // Too few confident keypoints in most frames.
+  Clip2D faint = good;
+  for (int t = 0; t < faint.num_frames(); ++t)
+    for (int j = 3; j < 17; ++j) faint.keypoints.at(t, j).confidence = 0.05;
+  expect_error(faint, "frames have");
+  // Settings are checked too.
+  FitOptions bad;
+  bad.fixed_focal_px = -5;
+  EXPECT_THROW(bad.Validate(), ConfigError);
+  bad = FitOptions();
+  bad.ground_weight = std::nan("");
+  EXPECT_THROW(bad.Validate(), ConfigError);
+}
+
+// Known failure, disabled until fixed (issue 11, notes): under a following
+// camera the fit keeps most of the walker's travel out of the root (0.7–0.9
+// of 2.9 m) and out of the camera path; the terms that should decide it
+// (non-sliding feet against camera smoothness) settle on a compromise.
+TEST(Fit, DISABLED_RecoversTheSubjectsPathUnderAFollowingCamera) {
+  // The camera dollies along with the walker: only relative motion is in
+  // the image; the feet that do not slide must tell the walk from the dolly.
+  auto character = Humanoid();
+  ReferenceBundle bundle =
+      SyntheticWalk(*character, 2, 3.0, CameraFollow::kRootDolly);
+  FitOptions options;
+  options.camera_motion = CameraMotion::kMoving;
+  options.progress = [](const std::string& line) {
+    std::printf("  %s\n", line.c_str());
+  };
+  const std::vector<Pose3D>& truth = bundle.ground_truth->poses;
+  const double true_travel_m =
+      (truth.back().root_position_m - truth.front().root_position_m)
+          .head<2>()
+          .norm();
+  for (size_t v = 0; v < bundle.views.size(); ++v) {
+    const ViewEstimate estimate =
+        FitView(bundle.views[v].clip, *character, options, "walk");
+    const double travel_m = (estimate.poses.back().root_position_m -
+                             estimate.poses.front().root_position_m)
+                                .head<2>()
+                                .norm();
+    const Eigen::Vector2d angles = CameraPitchRollRad(estimate.cameras[0]);
+    const Eigen::Vector2d true_angles =
+        CameraPitchRollRad(bundle.views[v].cameras[0]);
+    std::printf(
+        "%s\nview %zu: root travel %.2f m (true %.2f), pitch %.1f (%.1f), "
+        "roll %.1f (%.1f) deg, camera height %.2f (%.2f) m, "
+        "root-relative %.0f mm\n",
+        estimate.summary.BriefReport().c_str(), v, travel_m, true_travel_m,
+        angles[0] * 180 / M_PI, true_angles[0] * 180 / M_PI,
+        angles[1] * 180 / M_PI, true_angles[1] * 180 / M_PI,
+        estimate.cameras[0].CenterWorld().z(),
+        bundle.views[v].cameras[0].CenterWorld().z(),
+        1000 * YawAlignedRootRelativeErrorM(estimate.poses,
+                                            *bundle.ground_truth, *character));
+    EXPECT_NEAR(travel_m, true_travel_m, 0.2 * true_travel_m);
+  }
+}
+
+}  // namespace
+}  // namespace m2d

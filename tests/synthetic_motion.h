@@ -1,0 +1,108 @@
+// tests: motions and bundles made here, without the shared data — a pose
+// carried forward at walking speed with a swinging joint, and a synthetic
+// `mimic2d fit` estimate (the truth seen in another world frame).
+#ifndef MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
+#define MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "motion/bundle.h"
+#include "motion/motion3d.h"
+
+namespace m2d::testing {
+
+// `standing` carried along +x at `speed_m_s`, the last joint swinging by
+// 0.3 rad at 1 Hz about its parent's x axis, sampled at `fps`.
+inline Motion3D GlidingMotion(std::shared_ptr<const Skeleton> skeleton,
+                              const Pose3D& standing, double duration_s,
+                              double fps = 30.0, double speed_m_s = 0.5) {
+  Motion3D motion;
+  motion.skeleton = std::move(skeleton);
+  motion.fps = fps;
+  const int num_frames = static_cast<int>(std::round(duration_s * fps)) + 1;
+  for (int t = 0; t < num_frames; ++t) {
+    Pose3D pose = standing;
+    const double time_s = t / fps;
+    pose.root_position_m.x() += speed_m_s * time_s;
+    Eigen::Quaterniond& last = pose.local_rotations.back();
+    last = last *
+           Eigen::Quaterniond(Eigen::AngleAxisd(
+               0.3 * std::sin(2 * M_PI * time_s), Eigen::Vector3d::UnitX()));
+    motion.frames.push_back(pose);
+  }
+  return motion;
+}
+
+// The identity pose of `skeleton` with its root `height_m` above the floor.
+inline Pose3D IdentityPose(const Skeleton& skeleton, double height_m = 0.9) {
+  Pose3D pose;
+  pose.root_position_m = {0.0, 0.0, height_m};
+  pose.local_rotations.assign(skeleton.num_joints(),
+                              Eigen::Quaterniond::Identity());
+  return pose;
+}
+
+// The world moved by p' = R(yaw) p + shift (a rotation about z and a
+// horizontal shift): the same physical scene in another world frame.
+struct WorldChange {
+  double yaw_rad = 0.0;
+  Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();
+
+  Eigen::Matrix3d rotation() const {
+    return Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ())
+        .toRotationMatrix();
+  }
+  Eigen::Vector3d Point(const Eigen::Vector3d& p) const {
+    return rotation() * p + shift_m;
+  }
+  Pose3D Pose(Pose3D pose) const {
+    pose.root_position_m = Point(pose.root_position_m);
+    pose.local_rotations[0] =
+        Eigen::Quaterniond(rotation()) * pose.local_rotations[0];
+    return pose;
+  }
+  // The camera that sees the moved world as `camera` saw the original.
+  PinholeCamera Camera(const PinholeCamera& camera) const {
+    const Eigen::Matrix3d r =
+        camera.rotation_world_to_camera() * rotation().transpose();
+    return PinholeCamera(camera.intrinsics(), r,
+                         camera.translation_m() - r * shift_m);
+  }
+};
+
+// An estimate of every view made from `bundle`'s truth and true cameras:
+// view k seen in the world moved by `changes[k]` (so each view has its own
+// frame, as `mimic2d fit` gives).
+inline std::vector<ViewEstimate> EstimateFromTruth(
+    const ReferenceBundle& bundle, const std::vector<WorldChange>& changes) {
+  std::vector<ViewEstimate> estimate;
+  for (size_t k = 0; k < bundle.views.size(); ++k) {
+    const WorldChange& change = changes[k % changes.size()];
+    ViewEstimate view;
+    for (const PinholeCamera& camera : bundle.views[k].cameras)
+      view.cameras.push_back(change.Camera(camera));
+    view.skeleton_name = bundle.ground_truth->skeleton_name;
+    for (const Pose3D& pose : bundle.ground_truth->poses)
+      view.poses.push_back(change.Pose(pose));
+    view.residual_px.assign(bundle.num_frames(), 0.5);
+    view.summary.camera_model =
+        bundle.views[k].cameras.size() == 1 ? "static" : "moving";
+    view.summary.initialization = "synthetic";
+    view.summary.num_frames = bundle.num_frames();
+    view.summary.iterations = 12;
+    view.summary.initial_cost = 100.0;
+    view.summary.final_cost = 1.5;
+    view.summary.mean_reprojection_px = 0.5;
+    view.summary.seconds = 0.25;
+    estimate.push_back(std::move(view));
+  }
+  return estimate;
+}
+
+}  // namespace m2d::testing
+
+#endif  // MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
