@@ -57,6 +57,9 @@ TrainTiming MeasureTraining(TrainConfig config, int torch_threads,
                         ("mimic2d_bench_train_" + std::to_string(getpid()));
   config.run.run_dir = scratch;
   config.ppo.torch_threads = torch_threads;
+  // Each setting is measured as given: the config's thread tuner would
+  // switch counts mid-measurement (and rejects 1 thread as its maximum).
+  config.ppo.adapt_torch_threads = false;
   TrainTiming timing;
   {
     Trainer trainer(config, /*resume=*/false);
