@@ -64,6 +64,14 @@ Pose3D PlaceDefaultPose(const Character& character, const Pose3D& standing,
   return pose;
 }
 
+// Moves the character up by `height_m` (down when negative), keeping its
+// pose.
+void RaiseCharacter(double height_m, Simulation& simulation) {
+  simulation.mutable_data()
+      ->qpos[simulation.character().root_qpos_address() + 2] += height_m;
+  simulation.Refresh();
+}
+
 // Noisy S.I.: adds N(0, sigma) to every actuated hinge angle (kept within
 // the hinge's range), then moves the character vertically so that its
 // lowest point is where it was. Otherwise a leg bent by the noise would
@@ -81,9 +89,8 @@ void AddJointNoise(double sigma_rad, std::mt19937_64& rng,
                            hinge.range_high_rad);
   }
   simulation.Refresh();
-  data->qpos[character.root_qpos_address() + 2] +=
-      lowest_before_m - LowestCharacterPointZ(simulation);
-  simulation.Refresh();
+  RaiseCharacter(lowest_before_m - LowestCharacterPointZ(simulation),
+                 simulation);
 }
 
 // Keeps of `bundle` only what `sources` allow downstream (see Prepare);
@@ -308,12 +315,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
           QvelAtFrame(*character, poses, t, dt_s, &qvel);
           simulation.SetPose(poses[t], qvel.data());
           // A fitted pose may graze the floor: lift it out, never down.
-          const double lowest_m = LowestCharacterPointZ(simulation);
-          if (lowest_m < 0) {
-            simulation.mutable_data()
-                ->qpos[character->root_qpos_address() + 2] -= lowest_m;
-            simulation.Refresh();
-          }
+          RaiseCharacter(std::max(0.0, -LowestCharacterPointZ(simulation)),
+                         simulation);
           break;
         }
         case InitialStateSource::kDefault:

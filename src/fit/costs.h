@@ -242,43 +242,27 @@ struct TurnAccelerationCost {
   }
 };
 
-// weight x log(value / prior) on one element of a block: the focal length,
-// the camera's height.
+// weight x log(value / prior) on one element of a block: the focal length
+// (a 1-block), the camera's height (element 2 of its centre).
+template <int kBlockSize, int kIndex>
 struct LogPriorCost {
   double prior;
   double weight;
-  int index = 0;
 
   template <typename T>
   bool operator()(const T* block, T* residual) const {
     using std::log;
-    residual[0] = T(weight) * log(block[index] / T(prior));
+    residual[0] = T(weight) * log(block[kIndex] / T(prior));
     return true;
   }
 
-  static ceres::CostFunction* CreateOnHeight(double prior_m, double weight) {
-    return new ceres::AutoDiffCostFunction<LogPriorCost, 1, 3>(
-        new LogPriorCost{prior_m, weight, 2});
+  static ceres::CostFunction* Create(double prior, double weight) {
+    return new ceres::AutoDiffCostFunction<LogPriorCost, 1, kBlockSize>(
+        new LogPriorCost{prior, weight});
   }
 };
-
-// weight x log(focal / prior).
-struct FocalPriorCost {
-  double prior_px;
-  double weight;
-
-  template <typename T>
-  bool operator()(const T* focal_px, T* residual) const {
-    using std::log;
-    residual[0] = T(weight) * log(focal_px[0] / T(prior_px));
-    return true;
-  }
-
-  static ceres::CostFunction* Create(double prior_px, double weight) {
-    return new ceres::AutoDiffCostFunction<FocalPriorCost, 1, 1>(
-        new FocalPriorCost{prior_px, weight});
-  }
-};
+using FocalPriorCost = LogPriorCost<1, 0>;
+using CameraHeightPriorCost = LogPriorCost<3, 2>;
 
 }  // namespace m2d
 

@@ -140,6 +140,9 @@ struct Parameters {
   double* centre(int t) {
     return centres_m.size() == 1 ? centres_m[0].data() : centres_m[t].data();
   }
+  const double* centre(int t) const {
+    return centres_m.size() == 1 ? centres_m[0].data() : centres_m[t].data();
+  }
 };
 
 // The rest pose's keypoints (root at the origin, identity orientation, all
@@ -292,7 +295,7 @@ void RemoveContactSlide(const KinematicModel& model,
   // (a camera moves smoothly while a walker's speed changes every step).
   std::vector<Eigen::Vector2d> shift(num_frames, Eigen::Vector2d::Zero());
   for (int t = 1; t < num_frames; ++t) shift[t] = shift[t - 1] + steps[t];
-  constexpr int kHalfWindow = 15;  // frames
+  constexpr int kHalfWindow = 15;  // frames: a 1 s window at 30 fps
   for (int t = 0; t < num_frames; ++t) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     int count = 0;
@@ -450,7 +453,7 @@ void BuildProblem(Stage stage, const Observations& obs,
     // over a moving camera's frames so its strength does not grow with
     // the clip.
     problem.AddResidualBlock(
-        LogPriorCost::CreateOnHeight(
+        CameraHeightPriorCost::Create(
             options.camera_height_prior_m,
             options.camera_height_prior_weight / std::sqrt(num_centres)),
         nullptr, centre);
@@ -524,7 +527,7 @@ double FrameResidualPx(const Observations& obs, const KinematicModel& model,
 
 // "focal 2203 px, pitch 9.8 deg, roll 0.1 deg, height 1.62 m" (the first
 // frame's centre for a moving camera), for progress lines.
-std::string DescribeCamera(Parameters& params) {
+std::string DescribeCamera(const Parameters& params) {
   char text[128];
   std::snprintf(text, sizeof(text),
                 "focal %.0f px, pitch %.1f deg, roll %.1f deg, height %.2f m",

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "common/error.h"
+#include "eval/metrics.h"
 #include "fit/camera_model.h"
 #include "fit/costs.h"
 #include "fit/kinematics.h"
@@ -221,6 +222,8 @@ TEST(FitCosts, EveryTermsJacobianMatchesFiniteDifferences) {
                        "camera speed");
   ExpectGradientsMatch(FocalPriorCost::Create(2203.0, 2.0), {&focal}, {none},
                        "focal prior");
+  ExpectGradientsMatch(CameraHeightPriorCost::Create(1.5, 1.0), {centre},
+                       {none}, "camera height prior");
 }
 
 // A bundle of the walk seen by cameras at known places.
@@ -238,47 +241,18 @@ ReferenceBundle SyntheticWalk(const Character& character, int num_views,
                               "walk");
 }
 
-// Mean over frames of the root-relative keypoint error after the best
-// rotation about z for the whole clip (the fit's heading is its own).
+// Root-relative keypoint error of fitted poses after the best rotation about
+// z for the whole clip (the fit's heading is its own), in metres.
 double YawAlignedRootRelativeErrorM(const std::vector<Pose3D>& fitted,
                                     const GroundTruth3D& truth,
                                     const Character& character) {
-  const KeypointLayout& layout = character.keypoint_layout();
-  std::vector<std::vector<Eigen::Vector3d>> ours, theirs;
-  for (size_t t = 0; t < fitted.size(); ++t) {
-    std::vector<Eigen::Vector3d> points = KeypointPositions(
-        character.skeleton(), character.keypoint_map(), fitted[t]);
-    std::vector<Eigen::Vector3d> true_points = truth.keypoints_m[t];
-    Eigen::Vector3d root = Eigen::Vector3d::Zero(),
-                    true_root = Eigen::Vector3d::Zero();
-    for (int index : layout.root_keypoints) {
-      root += points[index] / layout.root_keypoints.size();
-      true_root += true_points[index] / layout.root_keypoints.size();
-    }
-    for (auto& p : points) p -= root;
-    for (auto& p : true_points) p -= true_root;
-    ours.push_back(points);
-    theirs.push_back(true_points);
+  KeypointFrames keypoints;
+  for (const Pose3D& pose : fitted) {
+    keypoints.push_back(KeypointPositions(character.skeleton(),
+                                          character.keypoint_map(), pose));
   }
-  double cross = 0, dot = 0;
-  for (size_t t = 0; t < ours.size(); ++t)
-    for (size_t j = 0; j < ours[t].size(); ++j) {
-      dot +=
-          ours[t][j].x() * theirs[t][j].x() + ours[t][j].y() * theirs[t][j].y();
-      cross +=
-          ours[t][j].x() * theirs[t][j].y() - ours[t][j].y() * theirs[t][j].x();
-    }
-  const Eigen::Matrix3d turn =
-      Eigen::AngleAxisd(std::atan2(cross, dot), Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
-  double sum = 0;
-  int count = 0;
-  for (size_t t = 0; t < ours.size(); ++t)
-    for (size_t j = 0; j < ours[t].size(); ++j) {
-      sum += (turn * ours[t][j] - theirs[t][j]).norm();
-      ++count;
-    }
-  return sum / count;
+  return YawAlignedRootRelativeError(keypoints, truth.keypoints_m,
+                                     character.keypoint_layout());
 }
 
 TEST(Fit, RecoversAKnownStaticCameraAndThePoses) {

@@ -41,6 +41,39 @@ void UseCiSizedLearning(const std::string& dir, TrainConfig* config) {
   config->Validate();
 }
 
+// The untrained and the trained policy (`checkpoint`) of `config`, each
+// rolled out the same way on `bundle` with the config's sources.
+struct BeforeAndAfter {
+  EvalRow before, after;
+};
+
+BeforeAndAfter EvaluateBeforeAndAfter(
+    const TrainConfig& config, const std::string& checkpoint,
+    std::shared_ptr<const Character> character, const ReferenceBundle& bundle,
+    const std::string& dir) {
+  TrackingTaskOptions task_options;
+  task_options.simulation = config.env.simulation;
+  task_options.sources = config.data.sources();
+  TrackingTask task = BuildTrackingTask(character, {bundle}, task_options);
+  EvalOptions eval;
+  eval.episodes_per_view = 3;
+  eval.episode_s = 1.5;
+  auto evaluate = [&](Policy& policy) {
+    return AggregateRows(EvaluatePolicy(policy, character, task.reference,
+                                        task.initial_states, config.env, eval));
+  };
+  TorchPolicy trained(checkpoint);
+  TrainConfig untrained_config = config;
+  untrained_config.run.run_dir = dir + "/untrained";
+  Trainer untrained_trainer(untrained_config, false);
+  untrained_trainer.SaveCheckpoint();
+  TorchPolicy untrained(untrained_trainer.checkpoint_path());
+  BeforeAndAfter result;
+  result.before = evaluate(untrained);
+  result.after = evaluate(trained);
+  return result;
+}
+
 TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
   const std::string walk_path =
       testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
@@ -66,24 +99,8 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
           .count();
 
   // Evaluate the untrained and the trained policy the same way.
-  auto reference = TrackingReference::Prepare({bundle}, *character,
-                                              config.env.simulation.control_hz);
-  auto states = std::make_shared<InitialStates>(
-      *reference, character, config.env.simulation, StateBufferOptions());
-  EvalOptions eval;
-  eval.episodes_per_view = 3;
-  eval.episode_s = 1.5;
-  TorchPolicy trained(summary.checkpoint_path);
-  EvalRow after = AggregateRows(
-      EvaluatePolicy(trained, character, reference, states, config.env, eval));
-
-  TrainConfig untrained_config = config;
-  untrained_config.run.run_dir = dir + "/untrained";
-  Trainer untrained_trainer(untrained_config, false);
-  untrained_trainer.SaveCheckpoint();
-  TorchPolicy untrained(untrained_trainer.checkpoint_path());
-  EvalRow before = AggregateRows(EvaluatePolicy(untrained, character, reference,
-                                                states, config.env, eval));
+  const auto [before, after] = EvaluateBeforeAndAfter(
+      config, summary.checkpoint_path, character, bundle, dir);
 
   std::printf("trained %lld samples in %.0f s (%.0f samples/s)\n",
               static_cast<long long>(summary.last.samples), seconds,
@@ -102,11 +119,11 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
 // bundle stripped of its 3D truth and cameras, then fitted; training and
 // evaluation start from the fitted poses and project with the fitted
 // cameras. Measured (4 views, moving cameras, 200k samples): frames before
-// the early exit 10.6 -> 14.2 of 45, E2D 31.5 -> 20.7 px. Less than from
+// the early exit 10.7 -> 14.3 of 45, E2D 30.6 -> 19.8 px. Less than from
 // 3D truth: the fit keeps the walker's travel out of its following cameras
 // (docs/fit.md, "Known limits"), so the starts ask for a walk in place.
 constexpr double kMin2dSurvivalGain = 1.15;  // measured 1.34x
-constexpr double kMax2dErrorRatio = 0.85;    // measured 0.66
+constexpr double kMax2dErrorRatio = 0.85;    // measured 0.65
 
 TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
   const std::string walk_path =
@@ -138,23 +155,8 @@ TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
   TrainSummary summary = trainer.Run(0, nullptr, nullptr);
 
   // Evaluated as trained: fitted starts and cameras.
-  TrackingTask task =
-      BuildTrackingTask(character, {fitted}, TrainingTaskOptions(config));
-  EvalOptions eval;
-  eval.episodes_per_view = 3;
-  eval.episode_s = 1.5;
-  TorchPolicy trained(summary.checkpoint_path);
-  EvalRow after =
-      AggregateRows(EvaluatePolicy(trained, character, task.reference,
-                                   task.initial_states, config.env, eval));
-  TrainConfig untrained_config = config;
-  untrained_config.run.run_dir = dir + "/untrained";
-  Trainer untrained_trainer(untrained_config, false);
-  untrained_trainer.SaveCheckpoint();
-  TorchPolicy untrained(untrained_trainer.checkpoint_path());
-  EvalRow before =
-      AggregateRows(EvaluatePolicy(untrained, character, task.reference,
-                                   task.initial_states, config.env, eval));
+  const auto [before, after] = EvaluateBeforeAndAfter(
+      config, summary.checkpoint_path, character, fitted, dir);
   std::printf(
       "from 2D only: untrained: Succ %.2f E2D %.1f px frames %.1f | trained: "
       "Succ %.2f E2D %.1f px frames %.1f\n",
