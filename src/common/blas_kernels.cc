@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 namespace m2d {
 namespace {
@@ -64,8 +66,23 @@ void UseFastestBlasKernels(char** argv) {
                preferred.c_str(), loaded.c_str());
 }
 
+std::string SgemmLibraryPath() {
+  void* sgemm = dlsym(RTLD_DEFAULT, "sgemm_");
+  Dl_info info;
+  if (sgemm == nullptr || dladdr(sgemm, &info) == 0 ||
+      info.dli_fname == nullptr)
+    return "";
+  char resolved[PATH_MAX];
+  return realpath(info.dli_fname, resolved) != nullptr
+             ? std::string(resolved)
+             : std::string(info.dli_fname);
+}
+
 std::string DescribeBlas() {
   const std::string loaded = LoadedOpenBlasCore();
+  const std::string sgemm = SgemmLibraryPath();
+  if (!sgemm.empty() && Lower(sgemm).find("openblas") == std::string::npos)
+    return "sgemm_ from " + sgemm + ", not OpenBLAS (slow; docs/benchmarks.md)";
   if (loaded.empty()) return "not OpenBLAS (install libopenblas0-openmp)";
   return "OpenBLAS (" + loaded + " kernels)";
 }

@@ -29,7 +29,14 @@ std::string LoadedOpenBlasCore();
 // (doing nothing) otherwise, or if the re-execution fails.
 void UseFastestBlasKernels(char** argv);
 
-// One line for logs, e.g. "OpenBLAS (SkylakeX kernels)" or "not OpenBLAS".
+// The file (symbolic links resolved) of the shared library that provides
+// sgemm_, the single-precision product LibTorch's linear layers call, in
+// this process; "" when no library does. Two libraries may export it (Ceres
+// brings ATLAS's libf77blas.so.3): the one loaded first wins.
+std::string SgemmLibraryPath();
+
+// One line for logs, e.g. "OpenBLAS (SkylakeX kernels)", or what provides
+// sgemm_ instead.
 std::string DescribeBlas();
 
 }  // namespace m2d

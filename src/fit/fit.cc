@@ -26,6 +26,7 @@ struct Observations {
   int num_keypoints = 0;
   int width_px = 0;
   int height_px = 0;
+  double fps = 30.0;
   std::vector<Eigen::Vector2d> pixel_px;  // T x J, frame-major
   std::vector<double> weight;             // T x J: confidence, 0 = unused
   std::vector<char> usable;               // per frame: enough keypoints
@@ -56,6 +57,7 @@ Observations ReadObservations(const Clip2D& clip, const FitOptions& options,
   obs.num_keypoints = clip.layout->num_keypoints();
   obs.width_px = clip.image_width_px;
   obs.height_px = clip.image_height_px;
+  obs.fps = clip.fps;
   if (obs.num_frames < options.min_frames) {
     throw InputError(source, "clip has " + std::to_string(obs.num_frames) +
                                  " frames; the fit needs at least " +
@@ -221,97 +223,205 @@ Parameters InitialParameters(const Observations& obs,
   return params;
 }
 
+// Leg-odometry passes before each contact round of a moving camera.
+constexpr int kOdometryPasses = 3;
+
 enum class Stage {
   kRoot,  // camera + root trajectory, torso keypoints, rest pose held
   kPose,  // + every hinge and keypoint, pose prior
   kPoseWithContacts,  // + feet that do not slide while in contact
 };
 
-// Per frame and sole point: how surely it touches the floor. Heights count
-// from the frame's lowest sole point, so that only the lower foot holds: a
-// swing foot skims the floor by a few centimetres, and labelling both feet
-// would make walking in place (both sliding) as cheap as walking.
-using ContactWeights = std::vector<std::vector<double>>;
-
-ContactWeights EstimateContacts(Parameters& params, const KinematicModel& model,
-                                const FitOptions& options) {
-  ContactWeights contacts;
+// Every frame's sole points in the world, 3 numbers each (T x S x 3).
+std::vector<std::vector<double>> SolePoints(Parameters& params,
+                                            const KinematicModel& model) {
   const int num_keypoints = model.num_keypoints();
   std::vector<double> points(3 * (num_keypoints + model.num_sole_points()));
+  std::vector<std::vector<double>> soles;
   for (size_t t = 0; t < params.root_m.size(); ++t) {
     CharacterPoints(model, params.root_m[t].data(),
                     params.quaternion_wxyz[t].data(),
                     params.hinges_rad[t].data(), points.data());
+    soles.emplace_back(points.begin() + 3 * num_keypoints, points.end());
+  }
+  return soles;
+}
+
+// Per frame and sole point: how surely it touches the floor. Heights count
+// from the frame's lowest sole point, so that only the lower foot holds: a
+// swing foot skims the floor by a few centimetres, and labelling both feet
+// would make walking in place (both sliding) as cheap as walking. With
+// `gate_by_speed`, a sole point moving faster than `contact_speed_mps` to
+// the next frame is not in contact either: a landing foot is the lowest a
+// frame before it stops.
+using ContactWeights = std::vector<std::vector<double>>;
+
+ContactWeights EstimateContacts(Parameters& params, const KinematicModel& model,
+                                const FitOptions& options, double fps,
+                                bool gate_by_speed) {
+  const std::vector<std::vector<double>> soles = SolePoints(params, model);
+  const int num_frames = static_cast<int>(soles.size());
+  const double max_step_m = options.contact_speed_mps / fps;
+  ContactWeights contacts;
+  for (int t = 0; t < num_frames; ++t) {
+    const std::vector<double>& sole = soles[t];
     double lowest_m = std::numeric_limits<double>::infinity();
     for (int s = 0; s < model.num_sole_points(); ++s)
-      lowest_m = std::min(lowest_m, points[3 * (num_keypoints + s) + 2]);
+      lowest_m = std::min(lowest_m, sole[3 * s + 2]);
     std::vector<double> weights;
     for (int s = 0; s < model.num_sole_points(); ++s) {
       // Above the floor (by more than the contact height) nothing holds.
-      const double above_lowest_m =
-          points[3 * (num_keypoints + s) + 2] - lowest_m;
+      const double above_lowest_m = sole[3 * s + 2] - lowest_m;
       const bool near_floor = lowest_m < 2.0 * options.contact_height_m;
-      weights.push_back(
+      double weight =
           near_floor && above_lowest_m < 2.0 * options.contact_height_m
               ? std::exp(-above_lowest_m / options.contact_height_m)
-              : 0.0);
+              : 0.0;
+      if (gate_by_speed && t + 1 < num_frames) {
+        const double step_m =
+            std::hypot(soles[t + 1][3 * s] - sole[3 * s],
+                       soles[t + 1][3 * s + 1] - sole[3 * s + 1]);
+        if (step_m > max_step_m) weight = 0.0;
+      }
+      weights.push_back(weight);
     }
     contacts.push_back(std::move(weights));
   }
   return contacts;
 }
 
+// The value below which half of the total weight lies.
+double WeightedMedian(std::vector<std::pair<double, double>> value_weight) {
+  std::sort(value_weight.begin(), value_weight.end());
+  double total = 0.0;
+  for (const auto& [value, weight] : value_weight) total += weight;
+  double below = 0.0;
+  for (const auto& [value, weight] : value_weight) {
+    below += weight;
+    if (below >= 0.5 * total) return value;
+  }
+  return 0.0;
+}
+
+// Where the ray through pixel `pixel_px` of frame t's camera meets the
+// horizontal plane at height `plane_z_m`; false when it does not (a ray
+// level or pointing up, or a point implausibly far).
+bool BackProjectToPlane(const Observations& obs, const Parameters& params,
+                        int t, const Eigen::Vector2d& pixel_px,
+                        double plane_z_m, Eigen::Vector3d* point_m) {
+  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
+  const Eigen::Vector3d ray =
+      rotation.transpose() *
+      Eigen::Vector3d((pixel_px.x() - 0.5 * obs.width_px) / params.focal_px,
+                      (pixel_px.y() - 0.5 * obs.height_px) / params.focal_px,
+                      1.0);
+  const Eigen::Vector3d centre(params.centre(t));
+  if (ray.z() > -1e-3) return false;
+  const double along = (plane_z_m - centre.z()) / ray.z();
+  constexpr double kMaxDistance_m = 100.0;
+  if (!(along > 0) || along * ray.norm() > kMaxDistance_m) return false;
+  *point_m = centre + along * ray;
+  return true;
+}
+
 // For a moving camera: shifts the subject and the camera together,
-// horizontally, so that the soles in contact stop sliding. Only the
-// relative motion of the two is in the image, so this leaves every
-// reprojection unchanged; it hands stage 3 the subject's travel, which a
-// local solver finds only slowly from a subject walking in place.
-void RemoveContactSlide(const KinematicModel& model,
+// horizontally, by the travel that keeps the feet in contact in place (leg
+// odometry). Only their relative motion is in the image, so this leaves
+// every reprojection unchanged; it hands stage 3 the subject's travel,
+// which a local solver does not find from a subject walking in place.
+//
+// A foot's step is measured on its observed 2D ankle, back-projected onto
+// the horizontal plane at the fitted ankle's height: the 2D and the ground
+// plane fix it, where the fitted leg's depth (a front view sees a stride
+// only as depth) is pulled toward rest by the pose prior. The camera's
+// step at frame t is minus the weighted median, over a window of about one
+// step, of the in-contact feet's steps: the stance foot moves with the
+// camera for most of the window, so a foot labelled in contact while it
+// lands or lifts (moving fast) is outvoted instead of averaged in.
+void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
+                        const KeypointLayout& layout,
                         const ContactWeights& contacts, Parameters& params) {
+  const int num_frames = obs.num_frames;
   const int num_keypoints = model.num_keypoints();
-  const int num_frames = static_cast<int>(params.root_m.size());
-  std::vector<double> before(3 * (num_keypoints + model.num_sole_points()));
-  std::vector<double> after(before.size());
-  std::vector<Eigen::Vector2d> steps(num_frames, Eigen::Vector2d::Zero());
-  for (int t = 0; t + 1 < num_frames; ++t) {
+  std::vector<std::vector<double>> points(num_frames);
+  for (int t = 0; t < num_frames; ++t) {
+    points[t].resize(3 * (num_keypoints + model.num_sole_points()));
     CharacterPoints(model, params.root_m[t].data(),
                     params.quaternion_wxyz[t].data(),
-                    params.hinges_rad[t].data(), before.data());
-    CharacterPoints(model, params.root_m[t + 1].data(),
-                    params.quaternion_wxyz[t + 1].data(),
-                    params.hinges_rad[t + 1].data(), after.data());
-    double total = 0.0;
-    Eigen::Vector2d slide = Eigen::Vector2d::Zero();
+                    params.hinges_rad[t].data(), points[t].data());
+  }
+  // Each foot's ankle keypoint: the one nearer its sole points.
+  const int ankles[2] = {layout.IndexOf("left_ankle"),
+                         layout.IndexOf("right_ankle")};
+  std::vector<int> foot_ankle(model.num_feet, -1);
+  for (int f = 0; f < model.num_feet; ++f) {
+    Eigen::Vector3d sole = Eigen::Vector3d::Zero();
     for (int s = 0; s < model.num_sole_points(); ++s) {
-      const double weight = std::min(contacts[t][s], contacts[t + 1][s]);
-      const int at = 3 * (num_keypoints + s);
-      slide += weight * Eigen::Vector2d(after[at] - before[at],
-                                        after[at + 1] - before[at + 1]);
-      total += weight;
+      if (model.sole_foot[s] == f)
+        sole += Eigen::Map<const Eigen::Vector3d>(
+            &points[0][3 * (num_keypoints + s)]);
     }
-    if (total > 0) steps[t + 1] = -slide / total;
+    double nearest_m = std::numeric_limits<double>::infinity();
+    for (int ankle : ankles) {
+      if (ankle < 0) continue;
+      const double distance_m =
+          (Eigen::Map<const Eigen::Vector3d>(&points[0][3 * ankle]) -
+           sole / 4.0)
+              .norm();
+      if (distance_m < nearest_m) {
+        nearest_m = distance_m;
+        foot_ankle[f] = ankle;
+      }
+    }
   }
-  // The subject takes the whole shift; the camera a moving average of it
-  // (a camera moves smoothly while a walker's speed changes every step).
+  // Per frame pair (t, t+1): each in-contact foot's horizontal step, and
+  // its weight (contact over the step times the ankles' confidence).
+  struct FootStep {
+    Eigen::Vector2d step_m;
+    double weight;
+  };
+  std::vector<std::vector<FootStep>> foot_steps(num_frames);
+  for (int t = 0; t + 1 < num_frames; ++t) {
+    for (int f = 0; f < model.num_feet; ++f) {
+      double contact = 0.0;
+      for (int s = 0; s < model.num_sole_points(); ++s) {
+        if (model.sole_foot[s] == f)
+          contact += std::min(contacts[t][s], contacts[t + 1][s]);
+      }
+      const int ankle = foot_ankle[f];
+      if (contact <= 0 || ankle < 0) continue;
+      const double confidence =
+          std::min(obs.Weight(t, ankle), obs.Weight(t + 1, ankle));
+      Eigen::Vector3d before, after;
+      if (confidence <= 0 ||
+          !BackProjectToPlane(obs, params, t, obs.Pixel(t, ankle),
+                              points[t][3 * ankle + 2], &before) ||
+          !BackProjectToPlane(obs, params, t + 1, obs.Pixel(t + 1, ankle),
+                              points[t + 1][3 * ankle + 2], &after)) {
+        continue;
+      }
+      foot_steps[t].push_back(
+          {(after - before).head<2>(), contact * confidence});
+    }
+  }
+  constexpr int kHalfWindow = 16;  // frames: a walking step at 30 fps
   std::vector<Eigen::Vector2d> shift(num_frames, Eigen::Vector2d::Zero());
-  for (int t = 1; t < num_frames; ++t) shift[t] = shift[t - 1] + steps[t];
-  constexpr int kHalfWindow = 15;  // frames: a 1 s window at 30 fps
-  for (int t = 0; t < num_frames; ++t) {
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    int count = 0;
+  for (int t = 0; t + 1 < num_frames; ++t) {
+    std::vector<std::pair<double, double>> along_x, along_y;
     for (int k = std::max(0, t - kHalfWindow);
-         k <= std::min(num_frames - 1, t + kHalfWindow); ++k) {
-      mean += shift[k];
-      ++count;
+         k <= std::min(num_frames - 2, t + kHalfWindow); ++k) {
+      for (const FootStep& foot : foot_steps[k]) {
+        along_x.emplace_back(foot.step_m.x(), foot.weight);
+        along_y.emplace_back(foot.step_m.y(), foot.weight);
+      }
     }
-    params.root_m[t].head<2>() += shift[t];
-    params.centres_m[t].head<2>() += mean / count;
+    const Eigen::Vector2d step(WeightedMedian(along_x),
+                               WeightedMedian(along_y));
+    shift[t + 1] = shift[t] - step;
   }
-  // The world origin stays below the first camera position.
-  const Eigen::Vector2d origin = params.centres_m[0].head<2>();
   for (int t = 0; t < num_frames; ++t) {
-    params.root_m[t].head<2>() -= origin;
-    params.centres_m[t].head<2>() -= origin;
+    params.root_m[t].head<2>() += shift[t];
+    params.centres_m[t].head<2>() += shift[t];
   }
 }
 
@@ -579,6 +689,8 @@ void FitOptions::Validate() const {
               pose_stage_iterations >= 1,
           "stage iterations must be >= 1");
   require(num_threads >= 1, "num_threads must be >= 1");
+  require(contact_speed_mps > 0 && std::isfinite(contact_speed_mps),
+          "contact_speed_mps must be > 0");
   require(contact_rounds >= 1, "contact_rounds must be >= 1");
   require(unconverged_residual_scale > 0,
           "unconverged_residual_scale must be > 0");
@@ -619,9 +731,11 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   summary.focal_fixed = options.fixed_focal_px > 0;
   summary.num_frames = obs.num_frames;
 
-  // Stage 1, from each facing start: a short screening solve each, then
-  // the lowest-cost start runs to convergence. Yaw pi faces the camera
-  // (which looks along +x).
+  // Stages 1 and 2, from each facing start: the camera and root to
+  // convergence, then a short full-pose solve; the start with the lowest
+  // full-pose cost continues. The torso alone hardly tells a walker seen
+  // from the side facing left from one facing right (their stage 1 costs
+  // tie); the legs do. Yaw pi faces the camera (which looks along +x).
   Parameters best;
   double best_cost = std::numeric_limits<double>::infinity();
   double best_turn_deg = 0.0;
@@ -630,21 +744,24 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
     Parameters params =
         InitialParameters(obs, model, rest, options, focal_prior_px,
                           M_PI + turn_deg * M_PI / 180.0);
-    StageResult result =
-        SolveStage(Stage::kRoot, options.screening_iterations, obs, model,
+    const StageResult root =
+        SolveStage(Stage::kRoot, options.root_stage_iterations, obs, model,
                    *clip.layout, options, focal_prior_px, nullptr, params);
-    summary.iterations += result.iterations;
-    char line[160];
+    const StageResult screen =
+        SolveStage(Stage::kPose, options.screening_iterations, obs, model,
+                   *clip.layout, options, focal_prior_px, nullptr, params);
+    summary.iterations += root.iterations + screen.iterations;
+    char line[200];
     std::snprintf(line, sizeof(line),
-                  "stage 1 (camera + root), start %d/%d (turned %.0f deg from "
-                  "facing the camera): cost %.4g -> %.4g",
-                  k + 1, options.num_facing_starts, turn_deg,
-                  result.initial_cost, result.final_cost);
+                  "stages 1-2, start %d/%d (turned %.0f deg from facing the "
+                  "camera): camera + root cost %.4g -> %.4g, full pose %.4g",
+                  k + 1, options.num_facing_starts, turn_deg, root.initial_cost,
+                  root.final_cost, screen.final_cost);
     say(line);
-    if (k == 0) summary.initial_cost = result.initial_cost;
-    if (result.final_cost < best_cost) {
+    if (k == 0) summary.initial_cost = root.initial_cost;
+    if (screen.final_cost < best_cost) {
       best = std::move(params);
-      best_cost = result.final_cost;
+      best_cost = screen.final_cost;
       best_turn_deg = turn_deg;
     }
   }
@@ -652,14 +769,8 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   std::snprintf(label, sizeof(label), "turned %.0f deg from facing the camera",
                 best_turn_deg);
   summary.initialization = label;
-  StageResult root =
-      SolveStage(Stage::kRoot, options.root_stage_iterations, obs, model,
-                 *clip.layout, options, focal_prior_px, nullptr, best);
-  summary.iterations += root.iterations;
-  say("stage 1 (camera + root): cost " + std::to_string(root.final_cost) +
-      "; " + DescribeCamera(best));
 
-  // Stage 2: the full pose.
+  // Stage 2 continues: the full pose.
   StageResult pose =
       SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
                  *clip.layout, options, focal_prior_px, nullptr, best);
@@ -672,9 +783,18 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   // and the root's motion sharpens the contacts.
   StageResult final_stage;
   for (int round = 0; round < options.contact_rounds; ++round) {
-    const ContactWeights contacts = EstimateContacts(best, model, options);
-    if (options.camera_motion == CameraMotion::kMoving)
-      RemoveContactSlide(model, contacts, best);
+    if (options.camera_motion == CameraMotion::kMoving) {
+      // Odometry from the height-labelled contacts, then again from
+      // contacts that also stand still once the travel is in: a swing foot
+      // labelled in contact moves fast then, and drops out.
+      for (int pass = 0; pass < kOdometryPasses; ++pass) {
+        RemoveContactSlide(
+            obs, model, *clip.layout,
+            EstimateContacts(best, model, options, obs.fps, pass > 0), best);
+      }
+    }
+    const ContactWeights contacts =
+        EstimateContacts(best, model, options, obs.fps, true);
     final_stage = SolveStage(
         Stage::kPoseWithContacts, options.pose_stage_iterations, obs, model,
         *clip.layout, options, focal_prior_px, &contacts, best);

@@ -56,19 +56,23 @@ struct FitOptions {
   // The camera's height is weakly observable when the subject stays at one
   // depth (a following camera): a prior at eye level, log(height / this).
   double camera_height_prior_m = 1.5;
-  double camera_height_prior_weight = 1.0;
+  double camera_height_prior_weight = 5.0;
   // Soles within this height of the floor count as in contact (for the
   // foot-slide term), weight falling off as exp(-height / this).
   double contact_height_m = 0.005;
+  // Sole points moving faster than this to the next frame are not in
+  // contact (a landing or lifting foot).
+  double contact_speed_mps = 0.5;
   int contact_rounds = 2;  // stage 3 solves, contacts relabelled before each
 
   // Initializations for the facing ambiguity: the character's heading is
   // tried at this many yaws evenly spaced (4: toward, away, both sides);
-  // the lowest cost after the first stage wins.
+  // each gets stage 1 and a short stage 2, and the lowest full-pose cost
+  // continues.
   int num_facing_starts = 4;
   // Solver: iterations per stage (and per round of stage 3).
-  int screening_iterations = 10;  // per facing start
-  int root_stage_iterations = 40;
+  int root_stage_iterations = 20;  // stage 1, per facing start
+  int screening_iterations = 10;   // stage 2's screening, per facing start
   int pose_stage_iterations = 50;
   int num_threads = 1;
   double function_tolerance = 1e-6;  // relative cost change that stops

@@ -342,11 +342,13 @@ TEST(Fit, RejectsInputItCannotUseWithANamedError) {
   EXPECT_THROW(bad.Validate(), ConfigError);
 }
 
-// Known failure, disabled until fixed (issue 11, notes): under a following
-// camera the fit keeps most of the walker's travel out of the root (0.7–0.9
-// of 2.9 m) and out of the camera path; the terms that should decide it
-// (non-sliding feet against camera smoothness) settle on a compromise.
-TEST(Fit, DISABLED_RecoversTheSubjectsPathUnderAFollowingCamera) {
+// Under a following camera only relative motion is in the image: the
+// subject's travel comes from feet that stay put while in contact (leg
+// odometry, then the foot-slide term). Measured (2 views, 3 s, focal
+// known): travel 2.59 and 2.91 m of 2.91. The camera's height is not
+// asserted: at one depth only h - d tan(pitch) is observed, and the 1.5 m
+// prior decides it (1.52 m against the rig's 2.06 m).
+TEST(Fit, RecoversTheSubjectsPathUnderAFollowingCamera) {
   // The camera dollies along with the walker: only relative motion is in
   // the image; the feet that do not slide must tell the walk from the dolly.
   auto character = Humanoid();
@@ -354,6 +356,9 @@ TEST(Fit, DISABLED_RecoversTheSubjectsPathUnderAFollowingCamera) {
       SyntheticWalk(*character, 2, 3.0, CameraFollow::kRootDolly);
   FitOptions options;
   options.camera_motion = CameraMotion::kMoving;
+  options.fixed_focal_px =
+      bundle.views[0].cameras[0].intrinsics().fx_px;  // a known lens
+  options.num_threads = 2;
   options.progress = [](const std::string& line) {
     std::printf("  %s\n", line.c_str());
   };
@@ -384,6 +389,7 @@ TEST(Fit, DISABLED_RecoversTheSubjectsPathUnderAFollowingCamera) {
         1000 * YawAlignedRootRelativeErrorM(estimate.poses,
                                             *bundle.ground_truth, *character));
     EXPECT_NEAR(travel_m, true_travel_m, 0.2 * true_travel_m);
+    EXPECT_LT(estimate.summary.mean_reprojection_px, 5.0);
   }
 }
 

@@ -21,14 +21,27 @@ TEST(BlasKernels, OpenBlasRunsTheKernelsTheCpuSupports) {
   torch::Tensor product = torch::ones({64, 64}).matmul(torch::ones({64, 64}));
   ASSERT_FLOAT_EQ(product[0][0].item<float>(), 64.0f);
   const std::string loaded = LoadedOpenBlasCore();
-  if (loaded.empty()) GTEST_SKIP() << "the BLAS in use is not OpenBLAS";
+  ASSERT_FALSE(loaded.empty())
+      << "the BLAS in use is not OpenBLAS (setup.sh installs "
+         "libopenblas0-openmp)";
   const std::string preferred = PreferredOpenBlasCore();
-  if (preferred.empty()) GTEST_SKIP() << "CPU has neither AVX2 nor AVX-512";
+  // A CPU with neither AVX2 nor AVX-512 has no faster kernels to ask for.
+  if (preferred.empty()) return;
   const std::string core = Lower(loaded);
   EXPECT_TRUE(core == "haswell" || core == "skylakex" || core == "cooperlake" ||
               core == "sapphirerapids" || core == "zen")
       << "OpenBLAS runs its " << loaded << " kernels; this CPU supports "
       << preferred << " (" << DescribeBlas() << ")";
+}
+
+// This binary links Ceres (m2d_fit), which brings ATLAS's libf77blas.so.3
+// with its own sgemm_: the link order must let OpenBLAS's win (CMakeLists,
+// m2d_blas_first), or every linear layer runs 4x slower.
+TEST(BlasKernels, LibTorchsMatrixProductsRunOnOpenBlas) {
+  const std::string sgemm = SgemmLibraryPath();
+  ASSERT_FALSE(sgemm.empty()) << "no library provides sgemm_";
+  EXPECT_NE(Lower(sgemm).find("openblas"), std::string::npos)
+      << "sgemm_ comes from " << sgemm;
 }
 
 }  // namespace
