@@ -82,7 +82,8 @@ std::string DescribeBlas() {
   const std::string loaded = LoadedOpenBlasCore();
   const std::string sgemm = SgemmLibraryPath();
   if (!sgemm.empty() && Lower(sgemm).find("openblas") == std::string::npos)
-    return "sgemm_ from " + sgemm + ", not OpenBLAS (slow; docs/benchmarks.md)";
+    return "sgemm_ from " + sgemm +
+           ", not OpenBLAS (slow; see m2d_blas_first in CMakeLists.txt)";
   if (loaded.empty()) return "not OpenBLAS (install libopenblas0-openmp)";
   return "OpenBLAS (" + loaded + " kernels)";
 }

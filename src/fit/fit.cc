@@ -232,19 +232,18 @@ enum class Stage {
   kPoseWithContacts,  // + feet that do not slide while in contact
 };
 
-// Every frame's sole points in the world, 3 numbers each (T x S x 3).
-std::vector<std::vector<double>> SolePoints(Parameters& params,
-                                            const KinematicModel& model) {
-  const int num_keypoints = model.num_keypoints();
-  std::vector<double> points(3 * (num_keypoints + model.num_sole_points()));
-  std::vector<std::vector<double>> soles;
-  for (size_t t = 0; t < params.root_m.size(); ++t) {
+// Every frame's keypoints then sole points in the world, 3 numbers each
+// (T x (J + S) x 3).
+std::vector<std::vector<double>> FramePoints(Parameters& params,
+                                             const KinematicModel& model) {
+  std::vector<std::vector<double>> points(params.root_m.size());
+  for (size_t t = 0; t < points.size(); ++t) {
+    points[t].resize(3 * (model.num_keypoints() + model.num_sole_points()));
     CharacterPoints(model, params.root_m[t].data(),
                     params.quaternion_wxyz[t].data(),
-                    params.hinges_rad[t].data(), points.data());
-    soles.emplace_back(points.begin() + 3 * num_keypoints, points.end());
+                    params.hinges_rad[t].data(), points[t].data());
   }
-  return soles;
+  return points;
 }
 
 // Per frame and sole point: how surely it touches the floor. Heights count
@@ -256,15 +255,16 @@ std::vector<std::vector<double>> SolePoints(Parameters& params,
 // frame before it stops.
 using ContactWeights = std::vector<std::vector<double>>;
 
-ContactWeights EstimateContacts(Parameters& params, const KinematicModel& model,
+ContactWeights EstimateContacts(const std::vector<std::vector<double>>& points,
+                                const KinematicModel& model,
                                 const FitOptions& options, double fps,
                                 bool gate_by_speed) {
-  const std::vector<std::vector<double>> soles = SolePoints(params, model);
-  const int num_frames = static_cast<int>(soles.size());
+  const int num_frames = static_cast<int>(points.size());
+  const int first_sole = 3 * model.num_keypoints();
   const double max_step_m = options.contact_speed_mps / fps;
   ContactWeights contacts;
   for (int t = 0; t < num_frames; ++t) {
-    const std::vector<double>& sole = soles[t];
+    const double* sole = &points[t][first_sole];
     double lowest_m = std::numeric_limits<double>::infinity();
     for (int s = 0; s < model.num_sole_points(); ++s)
       lowest_m = std::min(lowest_m, sole[3 * s + 2]);
@@ -278,9 +278,9 @@ ContactWeights EstimateContacts(Parameters& params, const KinematicModel& model,
               ? std::exp(-above_lowest_m / options.contact_height_m)
               : 0.0;
       if (gate_by_speed && t + 1 < num_frames) {
-        const double step_m =
-            std::hypot(soles[t + 1][3 * s] - sole[3 * s],
-                       soles[t + 1][3 * s + 1] - sole[3 * s + 1]);
+        const double* next = &points[t + 1][first_sole];
+        const double step_m = std::hypot(next[3 * s] - sole[3 * s],
+                                         next[3 * s + 1] - sole[3 * s + 1]);
         if (step_m > max_step_m) weight = 0.0;
       }
       weights.push_back(weight);
@@ -340,33 +340,29 @@ bool BackProjectToPlane(const Observations& obs, const Parameters& params,
 // lands or lifts (moving fast) is outvoted instead of averaged in.
 void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
                         const KeypointLayout& layout,
+                        const std::vector<std::vector<double>>& points,
                         const ContactWeights& contacts, Parameters& params) {
   const int num_frames = obs.num_frames;
   const int num_keypoints = model.num_keypoints();
-  std::vector<std::vector<double>> points(num_frames);
-  for (int t = 0; t < num_frames; ++t) {
-    points[t].resize(3 * (num_keypoints + model.num_sole_points()));
-    CharacterPoints(model, params.root_m[t].data(),
-                    params.quaternion_wxyz[t].data(),
-                    params.hinges_rad[t].data(), points[t].data());
-  }
   // Each foot's ankle keypoint: the one nearer its sole points.
   const int ankles[2] = {layout.IndexOf("left_ankle"),
                          layout.IndexOf("right_ankle")};
   std::vector<int> foot_ankle(model.num_feet, -1);
   for (int f = 0; f < model.num_feet; ++f) {
     Eigen::Vector3d sole = Eigen::Vector3d::Zero();
+    int count = 0;
     for (int s = 0; s < model.num_sole_points(); ++s) {
-      if (model.sole_foot[s] == f)
-        sole += Eigen::Map<const Eigen::Vector3d>(
-            &points[0][3 * (num_keypoints + s)]);
+      if (model.sole_foot[s] != f) continue;
+      sole += Eigen::Map<const Eigen::Vector3d>(
+          &points[0][3 * (num_keypoints + s)]);
+      ++count;
     }
+    if (count > 0) sole /= count;
     double nearest_m = std::numeric_limits<double>::infinity();
     for (int ankle : ankles) {
       if (ankle < 0) continue;
       const double distance_m =
-          (Eigen::Map<const Eigen::Vector3d>(&points[0][3 * ankle]) -
-           sole / 4.0)
+          (Eigen::Map<const Eigen::Vector3d>(&points[0][3 * ankle]) - sole)
               .norm();
       if (distance_m < nearest_m) {
         nearest_m = distance_m;
@@ -404,7 +400,7 @@ void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
           {(after - before).head<2>(), contact * confidence});
     }
   }
-  constexpr int kHalfWindow = 16;  // frames: a walking step at 30 fps
+  constexpr int kHalfWindow = 16;  // frames: a gait cycle at 30 fps
   std::vector<Eigen::Vector2d> shift(num_frames, Eigen::Vector2d::Zero());
   for (int t = 0; t + 1 < num_frames; ++t) {
     std::vector<std::pair<double, double>> along_x, along_y;
@@ -565,7 +561,9 @@ void BuildProblem(Stage stage, const Observations& obs,
     problem.AddResidualBlock(
         CameraHeightPriorCost::Create(
             options.camera_height_prior_m,
-            options.camera_height_prior_weight / std::sqrt(num_centres)),
+            (num_centres > 1 ? options.moving_camera_height_prior_weight
+                             : options.camera_height_prior_weight) /
+                std::sqrt(num_centres)),
         nullptr, centre);
   }
   for (int c = 1; c < num_centres; ++c) {
@@ -677,7 +675,8 @@ void FitOptions::Validate() const {
        {pose_prior_weight, pose_smooth_weight, root_smooth_weight,
         turn_smooth_weight, ground_weight, penetration_weight,
         foot_slide_weight, camera_smooth_weight, camera_speed_weight,
-        upright_weight, camera_height_prior_weight, focal_prior_weight}) {
+        upright_weight, camera_height_prior_weight,
+        moving_camera_height_prior_weight, focal_prior_weight}) {
     require(weight >= 0 && std::isfinite(weight),
             "term weights must be finite and >= 0");
   }
@@ -788,13 +787,14 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
       // contacts that also stand still once the travel is in: a swing foot
       // labelled in contact moves fast then, and drops out.
       for (int pass = 0; pass < kOdometryPasses; ++pass) {
+        const auto points = FramePoints(best, model);
         RemoveContactSlide(
-            obs, model, *clip.layout,
-            EstimateContacts(best, model, options, obs.fps, pass > 0), best);
+            obs, model, *clip.layout, points,
+            EstimateContacts(points, model, options, obs.fps, pass > 0), best);
       }
     }
-    const ContactWeights contacts =
-        EstimateContacts(best, model, options, obs.fps, true);
+    const ContactWeights contacts = EstimateContacts(
+        FramePoints(best, model), model, options, obs.fps, true);
     final_stage = SolveStage(
         Stage::kPoseWithContacts, options.pose_stage_iterations, obs, model,
         *clip.layout, options, focal_prior_px, &contacts, best);

@@ -56,7 +56,13 @@ struct FitOptions {
   // The camera's height is weakly observable when the subject stays at one
   // depth (a following camera): a prior at eye level, log(height / this).
   double camera_height_prior_m = 1.5;
-  double camera_height_prior_weight = 5.0;
+  double camera_height_prior_weight = 1.0;
+  // The same prior for a moving camera (spread over its centres). Stronger:
+  // at one depth only height - depth x tan(pitch) is observed, and at 1 two
+  // of four following views of the walk settled 0.7 m low, looking level
+  // (docs/fit.md). A static camera sees the subject change depth; 5 there
+  // pulled the test rig's 2.06 m camera to 1.54 m and rolled it 8-10 deg.
+  double moving_camera_height_prior_weight = 5.0;
   // Soles within this height of the floor count as in contact (for the
   // foot-slide term), weight falling off as exp(-height / this).
   double contact_height_m = 0.005;
