@@ -12,6 +12,7 @@ namespace {
 struct EvalArgs {
   std::string checkpoint;
   std::vector<std::string> bundles;
+  std::vector<std::string> truth_bundles;  // measurement only, per bundle
   std::string output;
   EvalOptions options;
   std::string starts;   // "": the checkpoint's config
@@ -24,7 +25,8 @@ int RunEval(const EvalArgs& args) {
     sources.initial_states = ParseInitialStateSource(args.starts);
   if (!args.cameras.empty()) sources.cameras = ParseCameraSource(args.cameras);
   CheckpointEvaluation evaluation =
-      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options, sources);
+      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options, sources,
+                         args.truth_bundles);
   PrintEvalTable(evaluation);
   if (!args.output.empty()) {
     WriteEvalJson(args.output, args.checkpoint, args.options, evaluation);
@@ -45,6 +47,11 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
       ->required();
   eval->add_option("--bundle", args->bundles,
                    "Reference bundles (default: the training bundles)");
+  eval->add_option(
+      "--truth", args->truth_bundles,
+      "Bundles holding the 3D truth of the evaluated ones, one per bundle "
+      "in the same order (a stripped bundle's original), for E3D only: the "
+      "policy and its task never read them");
   eval->add_option("--episodes", args->options.episodes_per_view,
                    "Episodes per view")
       ->capture_default_str();

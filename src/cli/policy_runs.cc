@@ -98,7 +98,8 @@ nlohmann::json RowToJson(const EvalRow& row) {
 
 CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,
-    const EvalOptions& options, const SourceOverrides& sources) {
+    const EvalOptions& options, const SourceOverrides& sources,
+    const std::vector<std::string>& truth_paths) {
   TorchPolicy policy(checkpoint);
   const TrainConfig& config = policy.config();
   std::vector<std::string> paths =
@@ -110,9 +111,31 @@ CheckpointEvaluation EvaluateCheckpoint(
                                         config.data.scene, paths, task_options);
   // Measurement only: the truth, read again from the files, goes to the
   // evaluator and never into the task the policy runs in.
+  if (!truth_paths.empty() && truth_paths.size() != paths.size()) {
+    throw ConfigError("--truth names " + std::to_string(truth_paths.size()) +
+                      " bundles for " + std::to_string(paths.size()) +
+                      " evaluated ones; give one per --bundle, in order");
+  }
   std::vector<std::optional<GroundTruth3D>> truth;
-  for (const std::string& path : paths)
-    truth.push_back(ReadBundle(path).ground_truth);
+  for (size_t b = 0; b < paths.size(); ++b) {
+    if (truth_paths.empty()) {
+      truth.push_back(ReadBundle(paths[b]).ground_truth);
+      continue;
+    }
+    const ReferenceBundle truth_bundle = ReadBundle(truth_paths[b]);
+    if (!truth_bundle.ground_truth) {
+      throw InputError(truth_paths[b],
+                       "has no ground_truth section to measure E3D against");
+    }
+    const int expected = task.reference->bundles()[b].num_frames();
+    if (truth_bundle.num_frames() != expected) {
+      throw InputError(truth_paths[b],
+                       "has " + std::to_string(truth_bundle.num_frames()) +
+                           " frames; the evaluated bundle " + paths[b] +
+                           " has " + std::to_string(expected));
+    }
+    truth.push_back(truth_bundle.ground_truth);
+  }
   evaluation.rows =
       EvaluatePolicy(policy, task.character, task.reference,
                      task.initial_states, config.env, options, truth);

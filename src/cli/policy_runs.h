@@ -30,10 +30,13 @@ struct CheckpointEvaluation {
 // Rolls the checkpoint's policy out on every view of `bundle_paths` (empty:
 // the bundles of its training config), with its training character and
 // environment settings and noise-free initial states. E3D is measured
-// against the truth read from the bundle files apart from the task.
+// against the truth read, apart from the task, from `truth_paths` (one per
+// bundle: e.g. the originals of stripped bundles; empty: the bundle files
+// themselves). A truth bundle must have the evaluated one's frame count.
 CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,
-    const EvalOptions& options, const SourceOverrides& sources = {});
+    const EvalOptions& options, const SourceOverrides& sources = {},
+    const std::vector<std::string>& truth_paths = {});
 
 // A header naming the sources, one line per row, then the episode-weighted
 // "all" row.

@@ -1,6 +1,7 @@
 #include "fit/fit.h"
 
 #include <ceres/ceres.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -590,6 +591,16 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
                        const KeypointLayout& layout, const FitOptions& options,
                        double focal_prior_px, const ContactWeights* contacts,
                        Parameters& params) {
+  // CHOLMOD's supernodal factorization opens an OpenMP region per
+  // supernode; on systems this small its threads spent 82 % of a fit's CPU
+  // time spinning at barriers (perf, with a training run on the other
+  // core) and made a 3-s clip's fit 7x slower. It runs on this thread.
+  const int saved_openmp_threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  struct RestoreOpenMpThreads {
+    int threads;
+    ~RestoreOpenMpThreads() { omp_set_num_threads(threads); }
+  } restore{saved_openmp_threads};
   ceres::Problem problem;
   BuildProblem(stage, obs, model, layout, options, focal_prior_px, contacts,
                params, problem);

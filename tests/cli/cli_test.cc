@@ -180,6 +180,31 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
   EXPECT_EQ(eval["cameras"], "estimate");
   EXPECT_TRUE(eval["all"]["e3d_mm"].is_null());  // worlds differ
   EXPECT_TRUE(eval["all"]["e3d_pa_mm"].is_number());
+  // The stripped-and-fitted file measured against the original's truth
+  // (--truth) gives the same figures: the rollouts never read it.
+  const std::string stripped_json = dir + "/eval_stripped.json";
+  result = RunMimic2d("eval " + policy + " --bundle " + fitted_path +
+                      " --truth " + full +
+                      " --starts estimate --cameras estimate --episodes 1 "
+                      "--episode-s 0.3 -o " +
+                      stripped_json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  nlohmann::json measured = ReadJsonFile(stripped_json);
+  ASSERT_TRUE(measured["all"]["e3d_root_mm"].is_number());
+  EXPECT_DOUBLE_EQ(measured["all"]["e3d_root_mm"].get<double>(),
+                   eval["all"]["e3d_root_mm"].get<double>());
+  EXPECT_DOUBLE_EQ(measured["all"]["e3d_pa_mm"].get<double>(),
+                   eval["all"]["e3d_pa_mm"].get<double>());
+  ExpectInputError("eval " + policy + " --bundle " + fitted_path +
+                       " --truth " + stripped_path +
+                       " --starts estimate --cameras estimate --episodes 1",
+                   stripped_path, "no ground_truth section");
+  result = RunMimic2d("eval " + policy + " --bundle " + fitted_path +
+                      " --truth " + full + " --truth " + full +
+                      " --starts estimate --cameras estimate --episodes 1");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("give one per --bundle"), std::string::npos)
+      << result.output;
   // Truth sources on the stripped file: a named error, not a crash.
   ExpectInputError(
       "eval " + policy + " --bundle " + fitted_path + " --episodes 1",
