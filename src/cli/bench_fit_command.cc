@@ -14,6 +14,7 @@
 #ifdef MIMIC2D_HAVE_SIM
 #include "common/file_io.h"
 #include "eval/fit_benchmark.h"
+#include "fit/fit_config.h"
 #include "sim/simulation.h"
 #endif
 
@@ -26,6 +27,9 @@ struct BenchFitArgs {
   int threads = 1;
   std::string output;  // JSON; empty: none
   std::string motion_dir;
+  std::string config;  // FitOptions YAML; "": the defaults
+  std::vector<std::string> settings;  // names; empty: all
+  std::string noise = "both";         // clean, noisy or both
   bool quick = false;
 };
 
@@ -38,6 +42,23 @@ int RunBenchFit(const BenchFitArgs& args) {
   options.clips = args.clips;
   options.num_views = args.views;
   options.num_threads = args.threads;
+  if (!args.config.empty()) options.fit = ReadFitOptions(args.config);
+  if (!args.settings.empty()) {
+    std::vector<FitCameraSetting> chosen;
+    for (const std::string& name : args.settings) {
+      bool found = false;
+      for (const FitCameraSetting& setting : options.settings) {
+        if (setting.name != name) continue;
+        chosen.push_back(setting);
+        found = true;
+      }
+      if (!found)
+        throw ConfigError("--settings: no camera setting '" + name + "'");
+    }
+    options.settings = chosen;
+  }
+  options.clean = args.noise != "noisy";
+  options.noisy = args.noise != "clean";
   if (args.quick) options.MakeQuick();
   options.progress = [](const std::string& line) {
     std::printf("%s\n", line.c_str());
@@ -117,10 +138,23 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
                   "Write the table as JSON (atomically)");
   fit->add_option("--motion-dir", args->motion_dir,
                   "Folder of the clips (default: assets/motions/deepmimic)");
+  fit->add_option("--config", args->config,
+                  "FitOptions as YAML for every fit (docs/fit.md, "
+                  "\"Settings\"); the camera model is each setting's");
+  CLI::Option* settings =
+      fit->add_option("--settings", args->settings,
+                      "Camera settings to run, e.g. A,B (default: all)")
+          ->delimiter(',');
+  CLI::Option* noise =
+      fit->add_option("--noise", args->noise, "clean, noisy or both")
+          ->check(CLI::IsMember({"clean", "noisy", "both"}))
+          ->capture_default_str();
   fit->add_flag("--quick", args->quick,
                 "Only the walk, clean 2D, setting A, one view (a smoke test)")
       ->excludes(clips)
-      ->excludes(views);
+      ->excludes(views)
+      ->excludes(settings)
+      ->excludes(noise);
   fit->callback([run, args] { *run = [args] { return RunBenchFit(*args); }; });
 }
 

@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "fit/fit.h"
+#include "fit/fit_config.h"
 #include "motion/bundle.h"
 #include "sim/simulation.h"
 
@@ -16,7 +17,10 @@ namespace {
 struct FitArgs {
   std::string input;
   std::string output;
-  std::string camera = "static";
+  std::string camera;  // "": the config's (default static)
+  std::string config;  // FitOptions YAML; "": the defaults
+  double focal_px = 0.0;
+  int threads = 0;  // 0: the config's (default 1)
   std::string character = "characters/humanoid.yaml";
   FitOptions options;
   bool quiet = false;
@@ -27,10 +31,15 @@ struct FitArgs {
 constexpr double kMaxUnconvergedFraction = 0.25;
 
 int RunFit(FitArgs& args) {
-  if (!ParseCameraMotion(args.camera, &args.options.camera_motion)) {
+  // The config file, then the command line's explicit settings over it.
+  if (!args.config.empty()) args.options = ReadFitOptions(args.config);
+  if (!args.camera.empty() &&
+      !ParseCameraMotion(args.camera, &args.options.camera_motion)) {
     throw ConfigError("--camera must be static or moving, not '" + args.camera +
                       "'");
   }
+  if (args.focal_px > 0) args.options.fixed_focal_px = args.focal_px;
+  if (args.threads > 0) args.options.num_threads = args.threads;
   if (!args.quiet) {
     args.options.progress = [](const std::string& line) {
       std::printf("    %s\n", line.c_str());
@@ -46,7 +55,7 @@ int RunFit(FitArgs& args) {
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
   std::printf("fitting %zu view(s) of %s (%d frames), camera %s, focal %s\n",
               bundle.views.size(), args.input.c_str(), bundle.num_frames(),
-              args.camera.c_str(),
+              CameraMotionName(args.options.camera_motion),
               args.options.fixed_focal_px > 0 ? "fixed" : "estimated");
   int failed_views = 0;
   ReferenceBundle fitted = FitBundle(
@@ -89,15 +98,19 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
   fit->add_option("-o,--output", args->output, "bundle with the estimate")
       ->required();
   fit->add_option("--camera", args->camera,
-                  "static (tripod) or moving (smooth per-frame position)")
-      ->default_val("static");
-  fit->add_option("--focal", args->options.fixed_focal_px,
-                  "known focal length in pixels (default: estimated)");
+                  "static (tripod) or moving (smooth per-frame position); "
+                  "default static");
+  fit->add_option("--focal", args->focal_px,
+                  "known focal length in pixels (default: estimated)")
+      ->check(CLI::PositiveNumber);
+  fit->add_option("--config", args->config,
+                  "FitOptions as YAML (docs/fit.md, \"Settings\"); the "
+                  "flags above and below override it");
   fit->add_option("--character", args->character,
                   "character config (relative to assets/ unless absolute)")
       ->default_val("characters/humanoid.yaml");
-  fit->add_option("--threads", args->options.num_threads, "solver threads")
-      ->default_val(1);
+  fit->add_option("--threads", args->threads, "solver threads (default 1)")
+      ->check(CLI::PositiveNumber);
   fit->add_flag("--quiet", args->quiet, "no per-stage progress lines");
   fit->callback([run, args] { *run = [args] { return RunFit(*args); }; });
 }

@@ -1,5 +1,6 @@
 #include "eval/fit_accuracy.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -8,6 +9,7 @@
 #include "fit/camera_model.h"
 #include "motion/motion3d.h"
 #include "sim/character.h"
+#include "sim/pose_mapping.h"
 
 namespace m2d {
 namespace {
@@ -27,6 +29,28 @@ void CheckCameraCount(size_t count, int num_frames, const char* what) {
         kSource, std::string(what) + " has " + std::to_string(count) +
                      " cameras; expected 1 or " + std::to_string(num_frames));
   }
+}
+
+// PA-MPJPE (m) of the true poses clamped to the character's hinge ranges
+// against the true keypoints; 0 without true poses.
+double ReachableFloorM(const GroundTruth3D& truth, const Character& character) {
+  if (truth.poses.size() != truth.keypoints_m.size() ||
+      truth.skeleton_name != character.skeleton().name) {
+    return 0.0;
+  }
+  std::vector<double> qpos(character.model()->nq, 0.0);
+  KeypointFrames clamped;
+  for (const Pose3D& pose : truth.poses) {
+    PoseToQpos(character, pose, qpos.data());
+    for (const ActuatedHinge& hinge : character.hinges()) {
+      double& angle = qpos[hinge.qpos_address];
+      angle = std::clamp(angle, hinge.range_low_rad, hinge.range_high_rad);
+    }
+    clamped.push_back(KeypointPositions(character.skeleton(),
+                                        character.keypoint_map(),
+                                        QposToPose(character, qpos.data())));
+  }
+  return ProcrustesAlignedError(clamped, truth.keypoints_m);
 }
 
 }  // namespace
@@ -100,6 +124,7 @@ FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
       YawAlignedRootRelativeError(fitted, truth.keypoints_m, *truth.layout);
   accuracy.pa_mpjpe_mm =
       1000.0 * ProcrustesAlignedError(fitted, truth.keypoints_m);
+  accuracy.reachable_pa_mpjpe_mm = 1000.0 * ReachableFloorM(truth, character);
 
   const FitSummary& summary = estimate.summary;
   accuracy.mean_reprojection_px = summary.mean_reprojection_px;
@@ -127,6 +152,7 @@ FitAccuracy MeanFitAccuracy(const std::vector<FitAccuracy>& accuracies) {
     mean.true_roll_deg += a.true_roll_deg / n;
     mean.root_relative_mpjpe_mm += a.root_relative_mpjpe_mm / n;
     mean.pa_mpjpe_mm += a.pa_mpjpe_mm / n;
+    mean.reachable_pa_mpjpe_mm += a.reachable_pa_mpjpe_mm / n;
     mean.mean_reprojection_px += a.mean_reprojection_px / n;
     mean.seconds_per_100_frames += a.seconds_per_100_frames / n;
     mean.unconverged_fraction += a.unconverged_fraction / n;

@@ -32,6 +32,11 @@ struct FitAccuracy {
   // (per-frame similarity alignment).
   double root_relative_mpjpe_mm = 0.0;
   double pa_mpjpe_mm = 0.0;
+  // The floor a fit on this character can reach: PA-MPJPE of the true
+  // poses with every hinge clamped to the character's range (a DeepMimic
+  // clip may bend joints further than the simulated character can; the
+  // fit holds its poses inside the ranges). 0 without true poses.
+  double reachable_pa_mpjpe_mm = 0.0;
   // From the fit's summary: confidence-weighted mean reprojection (px), wall
   // time scaled to 100 frames (s), share of frames that did not converge.
   double mean_reprojection_px = 0.0;

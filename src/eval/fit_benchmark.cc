@@ -76,12 +76,14 @@ ReferenceBundle MakeBenchmarkBundle(const Motion3D& motion,
 std::string AccuracyLine(const FitAccuracy& a) {
   return Format(
       "focal %.1f%% (%.0f px, true %.0f), pitch %.1f deg (%.1f, true %.1f), "
-      "roll %.1f deg, MPJPE %.0f mm, PA-MPJPE %.0f mm, reprojection %.1f px, "
+      "roll %.1f deg, MPJPE %.0f mm, PA-MPJPE %.0f mm (reachable %.0f), "
+      "reprojection %.1f px, "
       "%.1f s/100 frames (CPU %.1f s), %.0f%% unconverged",
       a.focal_error_pct, a.focal_px, a.true_focal_px, a.pitch_error_deg,
       a.pitch_deg, a.true_pitch_deg, a.roll_error_deg, a.root_relative_mpjpe_mm,
-      a.pa_mpjpe_mm, a.mean_reprojection_px, a.seconds_per_100_frames,
-      a.cpu_seconds_per_100_frames, 100.0 * a.unconverged_fraction);
+      a.pa_mpjpe_mm, a.reachable_pa_mpjpe_mm, a.mean_reprojection_px,
+      a.seconds_per_100_frames, a.cpu_seconds_per_100_frames,
+      100.0 * a.unconverged_fraction);
 }
 
 nlohmann::json AccuracyJson(const FitAccuracy& a) {
@@ -97,6 +99,7 @@ nlohmann::json AccuracyJson(const FitAccuracy& a) {
           {"true_roll_deg", a.true_roll_deg},
           {"root_relative_mpjpe_mm", a.root_relative_mpjpe_mm},
           {"pa_mpjpe_mm", a.pa_mpjpe_mm},
+          {"reachable_pa_mpjpe_mm", a.reachable_pa_mpjpe_mm},
           {"mean_reprojection_px", a.mean_reprojection_px},
           {"seconds_per_100_frames", a.seconds_per_100_frames},
           {"cpu_seconds_per_100_frames", a.cpu_seconds_per_100_frames},
@@ -228,7 +231,7 @@ FitBenchmarkResult RunFitBenchmark(const Character& character,
     const Motion3D motion = ReadDeepMimicMotion(options.MotionPath(clip),
                                                 character.shared_skeleton());
     for (const FitCameraSetting& setting : options.settings) {
-      FitOptions fit_options;
+      FitOptions fit_options = options.fit;
       fit_options.camera_motion = setting.fit_camera;
       fit_options.num_threads = options.num_threads;
       for (bool is_noisy : noise_levels) {
@@ -286,12 +289,14 @@ FitBenchmarkResult RunFitBenchmark(const Character& character,
 
 std::string FormatFitBenchmarkTable(const FitBenchmarkResult& result) {
   std::string text = Format(
-      "%-8s %-3s %-5s %5s %6s %7s %6s %6s %9s %9s %7s %7s %7s %7s\n", "clip",
-      "cam", "noise", "fits", "frames", "focal%", "pitch", "roll", "MPJPEroot",
-      "PA-MPJPE", "reproj", "s/100f", "cpu", "unconv");
-  text += Format("%-8s %-3s %-5s %5s %6s %7s %6s %6s %9s %9s %7s %7s %7s %7s\n",
-                 "", "", "", "", "", "", "(deg)", "(deg)", "(mm)", "(mm)",
-                 "(px)", "(s)", "(s)", "(%)");
+      "%-8s %-3s %-5s %5s %6s %7s %6s %6s %9s %9s %9s %7s %7s %7s %7s\n",
+      "clip", "cam", "noise", "fits", "frames", "focal%", "pitch", "roll",
+      "MPJPEroot", "PA-MPJPE", "reachable", "reproj", "s/100f", "cpu",
+      "unconv");
+  text += Format(
+      "%-8s %-3s %-5s %5s %6s %7s %6s %6s %9s %9s %9s %7s %7s %7s %7s\n", "",
+      "", "", "", "", "", "(deg)", "(deg)", "(mm)", "(mm)", "PA (mm)", "(px)",
+      "(s)", "(s)", "(%)");
   for (const TableLine& line : TableLines(result)) {
     const std::string frames =
         line.frames > 0 ? std::to_string(line.frames) : "";
@@ -304,9 +309,10 @@ std::string FormatFitBenchmarkTable(const FitBenchmarkResult& result) {
     }
     const FitAccuracy& a = line.accuracy;
     text +=
-        Format(" %7.1f %6.1f %6.1f %9.0f %9.0f %7.1f %7.1f %7.1f %7.0f\n",
+        Format(" %7.1f %6.1f %6.1f %9.0f %9.0f %9.0f %7.1f %7.1f %7.1f %7.0f\n",
                a.focal_error_pct, a.pitch_error_deg, a.roll_error_deg,
-               a.root_relative_mpjpe_mm, a.pa_mpjpe_mm, a.mean_reprojection_px,
+               a.root_relative_mpjpe_mm, a.pa_mpjpe_mm,
+               a.reachable_pa_mpjpe_mm, a.mean_reprojection_px,
                a.seconds_per_100_frames, a.cpu_seconds_per_100_frames,
                100.0 * a.unconverged_fraction);
   }
@@ -316,9 +322,9 @@ std::string FormatFitBenchmarkTable(const FitBenchmarkResult& result) {
 std::string FormatFitBenchmarkMarkdown(const FitBenchmarkResult& result) {
   std::string text =
       "| clip | camera | 2D | fits | frames | focal err % | pitch err ° | "
-      "roll err ° | MPJPE root-rel. (mm) | PA-MPJPE (mm) | reprojection (px) "
-      "| s / 100 frames (wall, CPU) | unconverged % |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "roll err ° | MPJPE root-rel. (mm) | PA-MPJPE (mm) | reachable PA (mm) "
+      "| reprojection (px) | s / 100 frames (wall, CPU) | unconverged % |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const TableLine& line : TableLines(result)) {
     const std::string frames =
         line.frames > 0 ? std::to_string(line.frames) : "";
@@ -328,14 +334,16 @@ std::string FormatFitBenchmarkMarkdown(const FitBenchmarkResult& result) {
         Format("| %s | %s | %s | %s | %s |", clip.c_str(), line.setting.c_str(),
                line.noise.c_str(), line.fits.c_str(), frames.c_str());
     if (line.empty) {
-      text += " every fit failed | | | | | | | |\n";
+      text += " every fit failed | | | | | | | | |\n";
       continue;
     }
     const FitAccuracy& a = line.accuracy;
     text += Format(
-        " %.1f | %.1f | %.1f | %.0f | %.0f | %.1f | %.1f, %.1f | %.0f |\n",
+        " %.1f | %.1f | %.1f | %.0f | %.0f | %.0f | %.1f | %.1f, %.1f | %.0f "
+        "|\n",
         a.focal_error_pct, a.pitch_error_deg, a.roll_error_deg,
-        a.root_relative_mpjpe_mm, a.pa_mpjpe_mm, a.mean_reprojection_px,
+        a.root_relative_mpjpe_mm, a.pa_mpjpe_mm, a.reachable_pa_mpjpe_mm,
+        a.mean_reprojection_px,
         a.seconds_per_100_frames, a.cpu_seconds_per_100_frames,
         100.0 * a.unconverged_fraction);
   }

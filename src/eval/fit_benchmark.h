@@ -45,6 +45,7 @@ struct FitBenchmarkOptions {
   int num_views = 2;            // rig views per bundle, each fitted on its own
   double max_duration_s = 4.0;  // clips longer than this are cut
   int num_threads = 1;          // Ceres threads per fit
+  FitOptions fit;  // every fit's settings (camera model and threads: above)
   // Called with a line before each fit and after it (empty: silent).
   std::function<void(const std::string& line)> progress;
 

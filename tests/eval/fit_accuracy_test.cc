@@ -69,6 +69,8 @@ TEST(MeasureFitAccuracy, TheTruthItselfHasNoError) {
   EXPECT_NEAR(accuracy.roll_error_deg, 0.0, 1e-9);
   EXPECT_NEAR(accuracy.root_relative_mpjpe_mm, 0.0, 1e-6);
   EXPECT_NEAR(accuracy.pa_mpjpe_mm, 0.0, 1e-3);
+  // The walk stays inside the character's joint ranges: nothing to clamp.
+  EXPECT_NEAR(accuracy.reachable_pa_mpjpe_mm, 0.0, 1e-3);
   // The rig's camera: elevation 10 deg looking at the subject, level.
   EXPECT_NEAR(accuracy.true_pitch_deg, 10.0, 1e-6);
   EXPECT_NEAR(accuracy.true_roll_deg, 0.0, 1e-9);
@@ -159,6 +161,29 @@ TEST(MeasureFitAccuracy, PosesInAnotherHeadingAndPlaceHaveNoPoseError) {
       bent, bundle.views[0].cameras, *bundle.ground_truth, *character);
   EXPECT_GT(bent_accuracy.root_relative_mpjpe_mm, 20.0);
   EXPECT_GT(bent_accuracy.pa_mpjpe_mm, 10.0);
+}
+
+// A truth bent past the character's joint ranges (a left hip raised 100 deg
+// sideways, as the DeepMimic kick does about 60 deg past the range) cannot
+// be fitted exactly: the reachable floor says how far it is.
+TEST(MeasureFitAccuracy, TruthBeyondTheJointRangesHasAReachableFloor) {
+  auto character = Humanoid();
+  ReferenceBundle bundle = WalkBundle(*character);
+  const ViewEstimate estimate = TruthAsEstimate(bundle, *character);
+  const int left_hip = character->skeleton().IndexOf("left_hip");
+  ASSERT_GE(left_hip, 0);
+  GroundTruth3D& truth = *bundle.ground_truth;
+  for (size_t t = 0; t < truth.poses.size(); ++t) {
+    Pose3D& pose = truth.poses[t];
+    pose.local_rotations[left_hip] =
+        Eigen::Quaterniond(Eigen::AngleAxisd(100 * kDeg, Eigen::Vector3d::UnitX()));
+    truth.keypoints_m[t] = KeypointPositions(character->skeleton(),
+                                             character->keypoint_map(), pose);
+  }
+  const FitAccuracy accuracy = MeasureFitAccuracy(
+      estimate, bundle.views[0].cameras, truth, *character);
+  EXPECT_GT(accuracy.reachable_pa_mpjpe_mm, 20.0);
+  EXPECT_LT(accuracy.reachable_pa_mpjpe_mm, accuracy.pa_mpjpe_mm);
 }
 
 TEST(MeasureFitAccuracy, ShapesThatDisagreeAreNamedErrors) {
