@@ -17,6 +17,8 @@ PACKAGES=(
   libopenblas0-openmp
   # libcairo2-dev: overlays, PNG and text on rendered frames (brings glib)
   libosmesa6-dev libcairo2-dev ffmpeg gnuplot-nox
+  # chromium: the test that opens the HTML report in a real (headless) browser
+  chromium
 )
 
 missing=()

@@ -62,11 +62,11 @@ struct BenchTask {
   }
 };
 
-// The DeepMimic walk when the shared data is present; else the humanoid's
-// default standing pose held still, so the benchmarks always run.
+// The DeepMimic walk (in the repository); the humanoid's default standing
+// pose held still if it is missing, so the benchmarks always run.
 Motion3D LoadMotion(const Character& character, double control_hz) {
   const std::string walk =
-      SourcePath("../shared/data/deepmimic/motions/humanoid3d_walk.txt");
+      SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
   if (std::filesystem::exists(walk))
     return ReadDeepMimicMotion(walk, character.shared_skeleton());
   Motion3D standing;

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -13,19 +14,35 @@ inline std::string SourcePath(const std::string& relative) {
   return std::string(MIMIC2D_SOURCE_DIR) + "/" + relative;
 }
 
-// ../shared/data/<relative> next to the repository; empty if absent.
+// Reference data a test reads: the repository's own copy first (the
+// DeepMimic humanoid clips under assets/motions/deepmimic/, MIT), then
+// ../shared/data/<relative> next to the repository (or under
+// $MIMIC2D_SHARED_DATA when set: CI points it at nothing to prove a fresh
+// clone needs no shared folder); empty if neither has it.
 inline std::string SharedDataPath(const std::string& relative) {
-  std::string path =
-      std::string(MIMIC2D_SOURCE_DIR) + "/../shared/data/" + relative;
+  const std::string deepmimic = "deepmimic/motions/";
+  if (relative.rfind(deepmimic, 0) == 0) {
+    const std::string in_repository = SourcePath(
+        "assets/motions/deepmimic/" + relative.substr(deepmimic.size()));
+    if (std::filesystem::exists(in_repository)) return in_repository;
+  }
+  const char* shared_override = std::getenv("MIMIC2D_SHARED_DATA");
+  const std::string shared =
+      shared_override != nullptr
+          ? std::string(shared_override)
+          : std::string(MIMIC2D_SOURCE_DIR) + "/../shared/data";
+  if (shared.empty()) return std::string();
+  const std::string path = shared + "/" + relative;
   return std::filesystem::exists(path) ? path : std::string();
 }
 
-// Skips the current test with a clear message when shared data is absent.
-#define M2D_REQUIRE_SHARED(var, relative)                           \
-  const std::string var = ::m2d::testing::SharedDataPath(relative); \
-  if (var.empty()) {                                                \
-    GTEST_SKIP() << "shared data ../shared/data/" << relative       \
-                 << " is absent; skipping";                         \
+// Fails the current test (never skips it: a fresh clone must run every
+// test) when the data it needs is in neither place.
+#define M2D_REQUIRE_SHARED(var, relative)                            \
+  const std::string var = ::m2d::testing::SharedDataPath(relative);  \
+  if (var.empty()) {                                                 \
+    GTEST_FAIL() << "test data " << relative                         \
+                 << " is neither under assets/ nor ../shared/data/"; \
   }
 
 // A fresh empty folder under the build's temp area.

@@ -7,11 +7,25 @@
 namespace m2d {
 
 void RigOptions::Validate() const {
-  if (num_views < 1) throw ConfigError("rig: num_views must be >= 1");
-  if (!(distance_m > 0.1)) throw ConfigError("rig: distance_m must be > 0.1");
-  if (!(focal_px > 0)) throw ConfigError("rig: focal_px must be > 0");
-  if (width_px < 1 || height_px < 1) {
-    throw ConfigError("rig: image size must be positive");
+  // More views than this is a typo (100000 views ran out of memory).
+  constexpr int kMaxViews = 256;
+  constexpr int kMaxImageSidePx = 65536;
+  if (num_views < 1 || num_views > kMaxViews) {
+    throw ConfigError("rig: num_views must be in [1, " +
+                      std::to_string(kMaxViews) + "], not " +
+                      std::to_string(num_views));
+  }
+  if (!std::isfinite(first_azimuth_deg) || !std::isfinite(azimuth_span_deg)) {
+    throw ConfigError("rig: azimuths must be finite");
+  }
+  if (!(distance_m > 0.1) || !std::isfinite(distance_m))
+    throw ConfigError("rig: distance_m must be finite and > 0.1");
+  if (!(focal_px > 0) || !std::isfinite(focal_px))
+    throw ConfigError("rig: focal_px must be finite and > 0");
+  if (width_px < 1 || height_px < 1 || width_px > kMaxImageSidePx ||
+      height_px > kMaxImageSidePx) {
+    throw ConfigError("rig: image sides must be in [1, " +
+                      std::to_string(kMaxImageSidePx) + "] px");
   }
   if (!(std::abs(elevation_deg) < 89.0)) {
     throw ConfigError("rig: |elevation_deg| must be < 89");

@@ -61,10 +61,9 @@ struct BenchEnvOptions {
   }
 };
 
-// The walk the env tests track, next to the repository.
+// The walk the env tests track (DeepMimic, MIT, in the repository).
 std::string DefaultMotionPath() {
-  return std::string(MIMIC2D_SOURCE_DIR) +
-         "/../shared/data/deepmimic/motions/humanoid3d_walk.txt";
+  return AssetPath("motions/deepmimic/humanoid3d_walk.txt");
 }
 
 #ifdef MIMIC2D_HAVE_SIM

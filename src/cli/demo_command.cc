@@ -20,11 +20,9 @@ namespace {
 struct DemoArgs {
   std::string motion = "/usr/share/assimp/models/BVH/01_01.bvh";
   std::string output_dir = "out/demo";
-  // The walk the committed policy was trained on (DeepMimic, MIT licence:
-  // read from the shared data folder, never copied into the repository).
-  std::string walk_motion = std::string(MIMIC2D_SOURCE_DIR) +
-                            "/../shared/data/deepmimic/motions/"
-                            "humanoid3d_walk.txt";
+  // The walk the committed policy was trained on (DeepMimic, MIT licence,
+  // carried with its LICENSE under assets/motions/deepmimic/).
+  std::string walk_motion = AssetPath("motions/deepmimic/humanoid3d_walk.txt");
   std::string walk_policy = AssetPath("policies/walk/checkpoint.pt");
 };
 

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <new>
 
 #include "cli/commands.h"
 #include "common/blas_kernels.h"
@@ -37,6 +38,27 @@ int main(int argc, char** argv) {
   m2d::cli::AddEvalCommand(app, &run);
   m2d::cli::AddFitCommand(app, &run);
   m2d::cli::AddBenchCommand(app, &run);
+  // No command, or one that does not exist: say so and list the commands
+  // (CLI11 alone says "A subcommand is required" for both).
+  std::string commands;
+  for (const CLI::App* command : app.get_subcommands({})) {
+    commands += (commands.empty() ? "" : ", ") + command->get_name();
+  }
+  if (argc < 2) {
+    std::cerr << "error: no command given; commands: " << commands
+              << " (mimic2d COMMAND --help for one)\n";
+    return 2;
+  }
+  const std::string first = argv[1];
+  bool known = false;
+  for (const CLI::App* command : app.get_subcommands({}))
+    known = known || command->check_name(first);
+  if (first.empty() || (first[0] != '-' && !known)) {
+    std::cerr << "error: unknown command '" << first
+              << "'; commands: " << commands
+              << " (mimic2d COMMAND --help for one)\n";
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -50,6 +72,10 @@ int main(int argc, char** argv) {
   } catch (const m2d::ConfigError& e) {
     std::cerr << "error: invalid setting: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "error: out of memory (a setting or input far larger than "
+                 "this machine can hold?)\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;

@@ -14,6 +14,15 @@
 namespace m2d {
 
 std::string ReadFileText(const std::string& path) {
+  // A folder or a device (/dev/null) opens and reads as empty: say so
+  // instead of handing an empty document to a parser that keeps defaults.
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) &&
+      !std::filesystem::is_regular_file(path, ec)) {
+    throw InputError(path, std::filesystem::is_directory(path, ec)
+                               ? "is a folder, not a file"
+                               : "is not a regular file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw InputError(
@@ -71,9 +80,22 @@ void WriteFileAtomic(const std::string& path, const std::string& contents) {
 
 nlohmann::json ReadJsonFile(const std::string& path) {
   std::string text = ReadFileText(path);
+  // No file of ours nests deeper than a few levels; a document nested
+  // thousands deep (fuzzing found a COCO bbox 50,000 deep) would exhaust
+  // the stack in code that walks it recursively.
+  constexpr int kMaxDepth = 64;
+  const nlohmann::json::parser_callback_t limit_depth =
+      [&path](int depth, nlohmann::json::parse_event_t,
+              nlohmann::json&) -> bool {
+    if (depth > kMaxDepth) {
+      throw InputError(path, "JSON nested more than " +
+                                 std::to_string(kMaxDepth) + " levels deep");
+    }
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+    return nlohmann::json::parse(text, limit_depth);
+  } catch (const nlohmann::json::exception& e) {
     throw InputError(path, std::string("malformed JSON: ") + e.what());
   }
 }

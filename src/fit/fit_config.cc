@@ -5,16 +5,8 @@
 
 namespace m2d {
 
-FitOptions ReadFitOptions(const std::string& path,
-                          const FitOptions& defaults) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, "cannot open");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path, std::string("malformed YAML: ") + e.what());
-  }
+FitOptions ReadFitOptions(const std::string& path, const FitOptions& defaults) {
+  const YAML::Node root = ReadYamlFile(path);
   if (root && !root.IsNull() && !root.IsMap())
     throw InputError(path, "expected a map of FitOptions fields");
   FitOptions options = defaults;
@@ -54,8 +46,7 @@ FitOptions ReadFitOptions(const std::string& path,
   section.Optional("unconverged_residual_scale",
                    &options.unconverged_residual_scale);
   section.Optional("min_frames", &options.min_frames);
-  section.Optional("min_keypoints_per_frame",
-                   &options.min_keypoints_per_frame);
+  section.Optional("min_keypoints_per_frame", &options.min_keypoints_per_frame);
   section.Optional("min_person_scale_px", &options.min_person_scale_px);
   section.Optional("min_usable_fraction", &options.min_usable_fraction);
   section.RejectUnknownKeys();

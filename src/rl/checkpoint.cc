@@ -3,11 +3,32 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
 
 #include "common/error.h"
+#include "common/file_io.h"
 
 namespace m2d {
 namespace {
+
+// A checkpoint file is LibTorch's zip archive followed by a trailer: this
+// magic and a 64-bit FNV-1a hash of the archive bytes. The archive stores
+// tensors uncompressed and LibTorch 1.13 does not check its CRCs, so a
+// flipped bit would otherwise load as a silently different weight. Files
+// without the trailer (written before it existed) load unchecked.
+constexpr char kTrailerMagic[8] = {'M', '2', 'D', 'C', 'K', 'S', 'U', 'M'};
+constexpr size_t kTrailerSize = sizeof(kTrailerMagic) + sizeof(uint64_t);
+
+uint64_t Fnv1a64(const char* data, size_t size) {
+  uint64_t hash = 14695981039346656037ull;
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= static_cast<unsigned char>(data[i]);
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
 
 // A SimState as one row of doubles, in a fixed field order; sizes come from
 // a template state of the same model.
@@ -105,26 +126,55 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
     }
   }
 
-  std::string temp = path + ".tmp." + std::to_string(::getpid());
+  // Serialized in memory, then written atomically: LibTorch writing to a
+  // full disk aborted the process (its zip writer throws from a destructor)
+  // and left a partial file; WriteFileAtomic reports the error by name and
+  // leaves the previous checkpoint in place.
+  std::ostringstream bytes;
   try {
-    archive.save_to(temp);
+    archive.save_to(bytes);
   } catch (const c10::Error& e) {
-    std::remove(temp.c_str());  // a partly written file is no checkpoint
-    throw InputError(path, "cannot write checkpoint: " +
+    throw InputError(path, "cannot serialize checkpoint: " +
                                std::string(e.what_without_backtrace()));
   }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    std::remove(temp.c_str());
-    throw InputError(path, "cannot write checkpoint");
+  std::string contents = bytes.str();
+  const uint64_t hash = Fnv1a64(contents.data(), contents.size());
+  contents.append(kTrailerMagic, sizeof(kTrailerMagic));
+  contents.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+  const std::string folder = ParentDirectory(path);
+  if (!std::filesystem::is_directory(folder)) {
+    throw InputError(
+        path, "cannot write checkpoint: folder " + folder + " does not exist");
+  }
+  try {
+    WriteFileAtomic(path, contents);
+  } catch (const InputError& e) {
+    throw InputError(path, "cannot write checkpoint: " + e.problem() +
+                               "; the previous checkpoint is unchanged");
   }
 }
 
 namespace {
 
 torch::serialize::InputArchive OpenArchive(const std::string& path) {
+  const std::string contents = ReadFileText(path);
+  size_t archive_size = contents.size();
+  if (contents.size() >= kTrailerSize &&
+      std::memcmp(contents.data() + contents.size() - kTrailerSize,
+                  kTrailerMagic, sizeof(kTrailerMagic)) == 0) {
+    archive_size = contents.size() - kTrailerSize;
+    uint64_t stored = 0;
+    std::memcpy(&stored, contents.data() + archive_size + sizeof(kTrailerMagic),
+                sizeof(stored));
+    if (Fnv1a64(contents.data(), archive_size) != stored) {
+      throw InputError(path,
+                       "checkpoint is corrupt (its checksum does not match "
+                       "its contents: a damaged or partly copied file)");
+    }
+  }
   torch::serialize::InputArchive archive;
   try {
-    archive.load_from(path);
+    archive.load_from(contents.data(), archive_size);
   } catch (const c10::Error& e) {
     throw InputError(path, "not a readable checkpoint (" +
                                std::string(e.what_without_backtrace()) + ")");

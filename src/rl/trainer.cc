@@ -147,6 +147,12 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.config = config;
   const RunOptions& run = config.run;
   std::filesystem::create_directories(run.run_dir);
+  // Temp files of a run killed mid-write (WriteFileAtomic's "<name>.tmp.
+  // <pid>"): never a checkpoint, only disk space.
+  for (const auto& entry : std::filesystem::directory_iterator(run.run_dir)) {
+    if (entry.path().filename().string().find(".tmp.") != std::string::npos)
+      std::filesystem::remove(entry.path());
+  }
   s.log_path = run.run_dir + "/train_log.csv";
   s.checkpoint_path = run.run_dir + "/checkpoint.pt";
   s.torch_threads = config.ppo.torch_threads;
@@ -383,6 +389,7 @@ TrainSummary Trainer::Run(
   s.envs->Reset();
   Clock::time_point last_checkpoint = Clock::now();
   std::ofstream log(s.log_path, std::ios::app);
+  if (!log) throw InputError(s.log_path, "cannot open the training log");
 
   while (s.counters.samples < config.run.total_samples) {
     if (stop != nullptr && stop->load()) {
@@ -474,6 +481,14 @@ TrainSummary Trainer::Run(
         << progress.approx_kl << ',' << progress.clip_fraction << ','
         << progress.torch_threads << '\n';
     log.flush();
+    if (!log) {
+      // A full disk: stop with the last checkpoint intact rather than train
+      // on with rows silently missing from the log.
+      throw InputError(s.log_path,
+                       "cannot append to the training log "
+                       "(disk full?); the last checkpoint is "
+                       "intact, resume with --resume");
+    }
     if (on_progress) on_progress(progress);
     summary.last = progress;
     ++summary.iterations_run;

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "camera/camera_io.h"
 #include "common/error.h"
@@ -46,6 +48,20 @@ TEST(Rig, ValidateRejectsBadSettings) {
   EXPECT_THROW(MakeRig(options), ConfigError);
   options = RigOptions();
   options.elevation_deg = 90;
+  EXPECT_THROW(MakeRig(options), ConfigError);
+  // Found by fuzzing: 100000 views ran out of memory (abort); a NaN azimuth
+  // made a bundle whose keypoints were all missing.
+  options = RigOptions();
+  options.num_views = 100000;
+  EXPECT_THROW(MakeRig(options), ConfigError);
+  options = RigOptions();
+  options.first_azimuth_deg = std::nan("");
+  EXPECT_THROW(MakeRig(options), ConfigError);
+  options = RigOptions();
+  options.focal_px = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(MakeRig(options), ConfigError);
+  options = RigOptions();
+  options.width_px = 1 << 20;
   EXPECT_THROW(MakeRig(options), ConfigError);
 }
 

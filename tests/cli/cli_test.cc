@@ -75,7 +75,8 @@ TEST(Cli, FromMotionWalkGivesFourViewsEqualToTheProjectedTruth) {
 TEST(Cli, BvhDemoMotionBecomesABundle) {
   const std::string bvh = "/usr/share/assimp/models/BVH/01_01.bvh";
   if (!std::ifstream(bvh))
-    GTEST_SKIP() << bvh << " absent (Debian assimp-testmodels)";
+    GTEST_FAIL() << bvh
+                 << " absent (Debian assimp-testmodels, installed by setup.sh)";
   std::string dir = testing::TempDir("cli_bvh");
   CommandResult result = RunMimic2d(
       "clip from-motion " + bvh + " --views 2 --follow -o " + dir + "/b.json");
@@ -195,8 +196,8 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
                    eval["all"]["e3d_root_mm"].get<double>());
   EXPECT_DOUBLE_EQ(measured["all"]["e3d_pa_mm"].get<double>(),
                    eval["all"]["e3d_pa_mm"].get<double>());
-  ExpectInputError("eval " + policy + " --bundle " + fitted_path +
-                       " --truth " + stripped_path +
+  ExpectInputError("eval " + policy + " --bundle " + fitted_path + " --truth " +
+                       stripped_path +
                        " --starts estimate --cameras estimate --episodes 1",
                    stripped_path, "no ground_truth section");
   result = RunMimic2d("eval " + policy + " --bundle " + fitted_path +
@@ -271,6 +272,46 @@ TEST(Cli, BadSettingsAreRejected) {
       RunMimic2d("clip from-motion " + walk + " --views 0 -o /tmp/never.json");
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("num_views"), std::string::npos)
+      << result.output;
+  // Found by fuzzing: an abort from running out of memory.
+  result = RunMimic2d("clip from-motion " + walk +
+                      " --views 100000 -o /tmp/never.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("num_views must be in [1, 256]"),
+            std::string::npos)
+      << result.output;
+}
+
+// Found by fuzzing: a document nested 50,000 deep crashed the reader
+// (stack overflow); a folder or /dev/null read as an empty file.
+TEST(Cli, DeepOrNonFileInputsAreNamedErrors) {
+  const std::string dir = testing::TempDir("cli_deep");
+  const std::string deep = WriteFile(
+      dir, "deep.json",
+      "{\"format\": \"mimic2d.clip\", \"bbox\": " + std::string(50000, '[') +
+          std::string(50000, ']') + "}");
+  ExpectInputError("clip info " + deep, deep, "nested more than 64 levels");
+  ExpectInputError("clip info " + dir, dir, "is a folder, not a file");
+  ExpectInputError("clip info /dev/null", "/dev/null", "not a regular file");
+}
+
+TEST(Cli, UnknownOrMissingCommandsListTheCommands) {
+  CommandResult result = RunMimic2d("frobnicate");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("unknown command 'frobnicate'"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("clip, demo"), std::string::npos)
+      << result.output;
+  result = RunMimic2d("");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("no command given"), std::string::npos)
+      << result.output;
+  // A command's own help, not the main one.
+  result = RunMimic2d("fit --help");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("mimic2d fit [OPTIONS] input"),
+            std::string::npos)
       << result.output;
 }
 

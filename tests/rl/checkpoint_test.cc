@@ -1,9 +1,11 @@
 #include "rl/checkpoint.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -215,6 +217,32 @@ TEST(Checkpoint, TruncatedOrForeignFilesAreInputErrorsNamingTheFile) {
     LoadCheckpoint(text, loaded.model, nullptr, nullptr, SimState());
   });
 
+  // One flipped bit inside a weight: the file still parses, the checksum
+  // does not match.
+  const std::string flipped = dir + "/flipped.pt";
+  fs::copy_file(path, flipped);
+  {
+    std::fstream file(flipped, std::ios::in | std::ios::out | std::ios::binary);
+    const std::streamoff middle =
+        static_cast<std::streamoff>(fs::file_size(flipped) / 2);
+    file.seekg(middle);
+    char byte = 0;
+    file.read(&byte, 1);
+    byte ^= 0x10;
+    file.seekp(middle);
+    file.write(&byte, 1);
+  }
+  std::string message;
+  try {
+    LoadCheckpoint(flipped, loaded.model, loaded.optimizer.get(), nullptr,
+                   SimState());
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find(flipped), std::string::npos) << message;
+  EXPECT_NE(message.find("checksum does not match"), std::string::npos)
+      << message;
+
   const std::string missing = dir + "/missing.pt";
   ExpectInputErrorNaming(missing, [&] {
     LoadCheckpoint(missing, loaded.model, nullptr, nullptr, SimState());
@@ -259,6 +287,38 @@ TEST(Checkpoint, AFailedSaveLeavesThePreviousCheckpoint) {
   EXPECT_EQ(read.wall_time_s, 12.5);
   EXPECT_TRUE(SameTensors(first.model->named_parameters(),
                           loaded.model->named_parameters()));
+
+  // A full disk (a file-size limit makes the write fail with EFBIG, as
+  // ENOSPC would): a named error, not an abort, and the previous checkpoint
+  // still loads.
+  fs::remove(blocked);
+  {
+    struct rlimit saved_limit;
+    ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &saved_limit), 0);
+    void (*saved_handler)(int) = std::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = saved_limit;
+    small.rlim_cur = 64 * 1024;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+    std::string message;
+    try {
+      SaveCheckpoint(path, TrainConfig(), second.model, *second.optimizer,
+                     counters, nullptr, SimState());
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    setrlimit(RLIMIT_FSIZE, &saved_limit);
+    std::signal(SIGXFSZ, saved_handler);
+    EXPECT_NE(message.find("cannot write checkpoint"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("previous checkpoint is unchanged"),
+              std::string::npos)
+        << message;
+  }
+  EXPECT_EQ(LoadCheckpoint(path, loaded.model, nullptr, nullptr, SimState())
+                .iteration,
+            5);
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 
   // Saving into a folder that does not exist fails and creates nothing.
   const std::string nowhere = dir + "/no_such_dir/checkpoint.pt";
