@@ -75,12 +75,12 @@ nlohmann::json RowToJson(const EvalRow& row) {
                          {"view", row.view},
                          {"episodes", row.episodes},
                          {"succ", row.succ},
-                         {"e2d_px", row.e2d_px},
+                         {"e2d_px", optional(row.e2d_px)},
                          {"eo2d_px", optional(row.eo2d_px)},
                          {"e3d_mm", optional(row.e3d_mm)},
                          {"e3d_root_mm", optional(row.e3d_root_mm)},
                          {"e3d_pa_mm", optional(row.e3d_pa_mm)},
-                         {"jitter", row.jitter},
+                         {"jitter", optional(row.jitter)},
                          {"mean_frames", row.mean_frames}};
   if (!row.rollouts.empty()) {
     json["rollouts"] = nlohmann::json::array();

@@ -8,6 +8,15 @@ YamlSection::YamlSection(YAML::Node node, std::string source, std::string where)
     throw InputError(source_, (where_.empty() ? "top level" : where_) +
                                   ": expected a mapping of settings");
   }
+  // yaml-cpp keeps the first of two equal keys; a second one is a mistake
+  // the user should hear about, not a silently ignored setting.
+  if (node_ && node_.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& entry : node_) {
+      const std::string key = entry.first.as<std::string>();
+      if (!seen.insert(key).second) Fail(key, "appears twice");
+    }
+  }
 }
 
 YAML::Node YamlSection::Child(const std::string& key) {
@@ -21,7 +30,8 @@ bool YamlSection::Has(const std::string& key) const {
 }
 
 YamlSection YamlSection::Section(const std::string& key) {
-  return YamlSection(Child(key), source_, where_.empty() ? key : where_ + "." + key);
+  return YamlSection(Child(key), source_,
+                     where_.empty() ? key : where_ + "." + key);
 }
 
 void YamlSection::RejectUnknownKeys() const {
@@ -32,8 +42,10 @@ void YamlSection::RejectUnknownKeys() const {
   }
 }
 
-void YamlSection::Fail(const std::string& key, const std::string& problem) const {
-  throw InputError(source_, "'" + (where_.empty() ? key : where_ + "." + key) + "' " + problem);
+void YamlSection::Fail(const std::string& key,
+                       const std::string& problem) const {
+  throw InputError(source_, "'" + (where_.empty() ? key : where_ + "." + key) +
+                                "' " + problem);
 }
 
 }  // namespace m2d

@@ -6,8 +6,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "common/error.h"
@@ -25,11 +27,18 @@ class YamlSection {
   void Optional(const std::string& key, T* value) {
     YAML::Node child = Child(key);
     if (!child || child.IsNull()) return;  // absent or empty: keep the default
+    T read;
     try {
-      *value = child.as<T>();
+      read = child.as<T>();
     } catch (const YAML::Exception&) {
       Fail(key, "has the wrong type");
     }
+    // No setting of ours means infinity or NaN (`.inf` trained to NaN and
+    // `max_episode_s: .inf` made 1-frame episodes): reject them here, once.
+    if constexpr (std::is_floating_point_v<T>) {
+      if (!std::isfinite(read)) Fail(key, "must be a finite number");
+    }
+    *value = read;
   }
   // A nested section (absent -> empty section).
   YamlSection Section(const std::string& key);

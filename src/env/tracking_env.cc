@@ -110,7 +110,10 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
   outcome.reward = static_cast<float>(outcome.terms.total);
 
   episode_.total_reward += outcome.terms.total;
-  episode_.sum_mean_error_px += outcome.error.mean_px;
+  if (outcome.error.num_present > 0) {
+    ++episode_.measured_steps;
+    episode_.sum_mean_error_px += outcome.error.mean_px;
+  }
   episode_.max_error_px = std::max(episode_.max_error_px, outcome.error.max_px);
 
   if (options_.early_exit &&

@@ -51,13 +51,16 @@ struct EpisodeStats {
   int view_index = 0;  // into TrackingReference::views()
   int start_frame = 0;
   int steps = 0;
+  // Steps whose reference frame had at least one keypoint to compare with
+  // (a frame with none cannot be judged: it is neither error nor success).
+  int measured_steps = 0;
   double total_reward = 0.0;
-  double sum_mean_error_px = 0.0;  // sum over steps of the frame's mean
+  double sum_mean_error_px = 0.0;  // sum over measured steps of the mean
   double max_error_px = 0.0;       // worst keypoint over the episode
   bool failed = false;             // ended by early exit or divergence
 
   double mean_error_px() const {
-    return steps ? sum_mean_error_px / steps : 0.0;
+    return measured_steps ? sum_mean_error_px / measured_steps : 0.0;
   }
 };
 

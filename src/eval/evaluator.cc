@@ -69,6 +69,9 @@ std::vector<EvalRow> EvaluatePolicy(
     row.view = bundle.views[view.view].name;
     double succ = 0, e2d = 0, eo2d = 0, e3d = 0, e3d_root = 0, e3d_pa = 0,
            jitter = 0, frames = 0;
+    // Rollouts that measured anything: one that diverged on its first step
+    // (a start below the floor) has no error to average, not an error of 0.
+    int measured_2d = 0, measured_3d = 0;
     const int last_start = std::max(0, view.num_frames - 1 - episode_frames);
     for (int e = 0; e < options.episodes_per_view; ++e) {
       int start = options.episodes_per_view == 1
@@ -111,13 +114,23 @@ std::vector<EvalRow> EvaluatePolicy(
         if (outcome.terminated || outcome.truncated) break;
       }
       const EpisodeStats& stats = env.episode();
+      // A rollout succeeds when no frame failed and most of its frames
+      // could be judged: a reference missing its keypoints is no success.
+      const bool succeeded = !stats.failed &&
+                             2 * stats.measured_steps >= stats.steps &&
+                             stats.measured_steps > 0;
       row.rollouts.push_back(
-          {start, stats.steps, !stats.failed, stats.mean_error_px()});
-      succ += stats.failed ? 0.0 : 1.0;
-      e2d += stats.mean_error_px();
+          {start, stats.steps, succeeded, stats.mean_error_px()});
+      succ += succeeded ? 1.0 : 0.0;
       frames += stats.steps;
-      jitter += MeanJerk(simulated, eval_env.simulation.control_hz);
+      if (stats.measured_steps > 0) {
+        e2d += stats.mean_error_px();
+        ++measured_2d;
+      }
       if (object_frames > 0) eo2d += object_error / object_frames;
+      if (simulated.empty()) continue;
+      ++measured_3d;
+      jitter += MeanJerk(simulated, eval_env.simulation.control_hz);
       if (has_truth) {
         e3d += 1000.0 * MeanPositionError(simulated, true_keypoints);
         e3d_root +=
@@ -131,14 +144,14 @@ std::vector<EvalRow> EvaluatePolicy(
     const double n = options.episodes_per_view;
     row.episodes = options.episodes_per_view;
     row.succ = succ / n;
-    row.e2d_px = e2d / n;
-    row.jitter = jitter / n;
+    row.e2d_px = measured_2d > 0 ? e2d / measured_2d : -1.0;
+    row.jitter = measured_3d > 0 ? jitter / measured_3d : -1.0;
     row.mean_frames = frames / n;
     if (reference->num_object_points() > 0) row.eo2d_px = eo2d / n;
-    if (has_truth) {
-      if (same_world) row.e3d_mm = e3d / n;
-      row.e3d_root_mm = e3d_root / n;
-      row.e3d_pa_mm = e3d_pa / n;
+    if (has_truth && measured_3d > 0) {
+      if (same_world) row.e3d_mm = e3d / measured_3d;
+      row.e3d_root_mm = e3d_root / measured_3d;
+      row.e3d_pa_mm = e3d_pa / measured_3d;
     }
     rows.push_back(row);
   }

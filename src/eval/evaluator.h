@@ -34,8 +34,13 @@ struct EvalRow {
   std::string bundle;
   std::string view;
   int episodes = 0;
-  double succ = 0.0;      // fraction of successful rollouts
-  double e2d_px = 0.0;    // mean per-frame mean 2D error (until failure)
+  // Fraction of successful rollouts: no frame over the threshold, and at
+  // least half of the frames had reference keypoints to judge them by.
+  double succ = 0.0;
+  // Mean per-frame mean 2D error (until failure) over the frames that had
+  // reference keypoints; -1 when no rollout measured any (e.g. every start
+  // diverged at once). E3D and Jitter likewise (-1: nothing simulated).
+  double e2d_px = 0.0;
   double eo2d_px = -1.0;  // objects' 2D error; -1 without objects
   // Against the 3D truth (-1 without it). Global error only when the
   // cameras are the true ones (the worlds agree; else -1); root-relative

@@ -198,7 +198,11 @@ bool PoseIsFinite(const Pose3D& pose) {
 
 void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
   if (bundle.views.empty()) throw InputError(source, "bundle has no views");
-  if (!(bundle.fps > 0)) throw InputError(source, "fps must be positive");
+  if (!(bundle.fps >= kMinClipFps && bundle.fps <= kMaxClipFps)) {
+    throw InputError(source, "fps " + std::to_string(bundle.fps) +
+                                 " is outside [" + std::to_string(kMinClipFps) +
+                                 ", " + std::to_string(kMaxClipFps) + "]");
+  }
   const int num_frames = bundle.num_frames();
   for (const ReferenceView& view : bundle.views) {
     ValidateClip(view.clip, source + " (view " + view.name + ")");

@@ -27,11 +27,16 @@ void ValidatePoint(const Keypoint2D& point, const std::string& source,
 
 void ValidateClip(const Clip2D& clip, const std::string& source) {
   if (clip.layout == nullptr) throw InputError(source, "clip has no layout");
-  if (!(clip.fps > 0.0 && std::isfinite(clip.fps))) {
-    throw InputError(source, "fps must be a positive number");
+  if (!(clip.fps >= kMinClipFps && clip.fps <= kMaxClipFps)) {
+    throw InputError(source, "fps " + std::to_string(clip.fps) +
+                                 " is outside [" + std::to_string(kMinClipFps) +
+                                 ", " + std::to_string(kMaxClipFps) + "]");
   }
-  if (clip.image_width_px < 1 || clip.image_height_px < 1) {
-    throw InputError(source, "image size must be positive");
+  if (clip.image_width_px < 1 || clip.image_height_px < 1 ||
+      clip.image_width_px > kMaxImageSidePx ||
+      clip.image_height_px > kMaxImageSidePx) {
+    throw InputError(source, "image size must be in [1, " +
+                                 std::to_string(kMaxImageSidePx) + "] px");
   }
   if (clip.num_frames() < 1) throw InputError(source, "clip has no frames");
   if (clip.keypoints.num_keypoints() != clip.layout->num_keypoints()) {

@@ -69,7 +69,14 @@ struct Clip2D {
   double duration_s() const { return num_frames() / fps; }
 };
 
-// Checks the invariants above (positive fps and image size, matching shapes,
+// Plausible bounds of a recording: anything outside is a broken file (fuzzing
+// found 1e-320 and 1e308 fps accepted, and image sides past 2^31 wrapped).
+inline constexpr double kMinClipFps = 1.0;
+inline constexpr double kMaxClipFps = 1000.0;
+inline constexpr long kMaxImageSidePx = 65536;
+
+// Checks the invariants above (fps and image size within the bounds above,
+// matching shapes,
 // confidences in [0, 1], no NaN on a keypoint with confidence > 0, at least
 // one frame). Throws InputError with `source` (a file name) on failure.
 void ValidateClip(const Clip2D& clip, const std::string& source);

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <utility>
 
 #include "common/error.h"
 #include "common/file_io.h"
@@ -426,10 +427,15 @@ Clip2D ClipFromJson(const JsonCursor& cursor) {
   Clip2D clip;
   clip.layout = LayoutFromJson(cursor.Field("layout"));
   clip.fps = cursor.Field("fps").Number();
-  clip.image_width_px =
-      static_cast<int>(cursor.Field("image_width_px").Integer());
-  clip.image_height_px =
-      static_cast<int>(cursor.Field("image_height_px").Integer());
+  // Read wide and bounded before narrowing: a side past 2^31 must not wrap
+  // into a plausible one.
+  for (auto [key, side] :
+       {std::pair{"image_width_px", &clip.image_width_px},
+        std::pair{"image_height_px", &clip.image_height_px}}) {
+    const long value = cursor.Field(key).Integer();
+    *side =
+        value >= 1 && value <= kMaxImageSidePx ? static_cast<int>(value) : -1;
+  }
   clip.keypoints = KeypointsFromJson(cursor.Field("keypoints"), *clip.layout);
   if (cursor.Has("objects")) {
     JsonCursor objects = cursor.Field("objects");

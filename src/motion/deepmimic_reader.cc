@@ -1,5 +1,6 @@
 // motion: the DeepMimic motion-file reader.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "common/error.h"
@@ -48,7 +49,12 @@ Motion3D ReadDeepMimicMotion(const std::string& path,
   JsonCursor root(json, path);
   Motion3D raw;
   raw.skeleton = skeleton;
-  raw.loops = root.Has("Loop") && root.Field("Loop").String() == "wrap";
+  // DeepMimic writes "wrap" or "none"; compare without case ("Wrap").
+  if (root.Has("Loop")) {
+    std::string loop = root.Field("Loop").String();
+    for (char& c : loop) c = static_cast<char>(std::tolower(c));
+    raw.loops = loop == "wrap";
+  }
 
   size_t frame_length = 1 + 3 + 4;
   for (int j = 1; j < skeleton->num_joints(); ++j) {

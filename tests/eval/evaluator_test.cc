@@ -113,6 +113,41 @@ TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
   EXPECT_EQ(all.mean_frames, 15.0);
 }
 
+// Found by fuzzing: a reference whose keypoints are all missing after frame
+// 2 evaluated to Succ 100 %, E2D 0. Frames without reference keypoints
+// cannot be judged; a rollout made mostly of them is no success, and E2D
+// averages only the frames it could measure.
+TEST(EvaluatePolicy, AMissingReferenceIsNoSuccess) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  auto character = testing::LoadHumanoid(SimulationOptions());
+  ReferenceBundle bundle = testing::MakeWalkBundle(path, *character, 2.0);
+  for (ReferenceView& view : bundle.views) {
+    for (int t = 3; t < view.clip.num_frames(); ++t) {
+      for (int j = 0; j < view.clip.keypoints.num_keypoints(); ++j)
+        view.clip.keypoints.at(t, j) = Keypoint2D();
+    }
+  }
+  TrackingTaskOptions task_options;
+  TrackingTask task = BuildTrackingTask(character, {bundle}, task_options);
+  TrackingEnvOptions env_options;
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  env_options, 0);
+  ZeroPolicy policy(env.observation_size(), env.action_size());
+  EvalOptions options;
+  options.episodes_per_view = 1;
+  options.episode_s = 1.0;
+  options.success_threshold_px = 1e6;  // no measured frame can fail
+  const std::vector<EvalRow> rows =
+      EvaluatePolicy(policy, task.character, task.reference,
+                     task.initial_states, env_options, options);
+  ASSERT_FALSE(rows.empty());
+  for (const EvalRow& row : rows) {
+    SCOPED_TRACE(row.view);
+    EXPECT_EQ(row.succ, 0.0);
+    EXPECT_GT(row.e2d_px, 0.0);  // the two measured frames, not 0
+  }
+}
+
 // A policy that never saw the truth (estimated cameras and starts) is
 // still measured against it when it is handed to the evaluator: no global
 // E3D (the worlds differ), root-relative E3D after the best yaw, PA-MPJPE.

@@ -222,6 +222,23 @@ TEST_F(ClipIoBadInput, NonPositiveFps) {
   EXPECT_NE(message.find("fps"), std::string::npos) << message;
 }
 
+// Found by fuzzing: absurd rates were accepted, and an image side past 2^31
+// wrapped into a plausible one.
+TEST_F(ClipIoBadInput, AbsurdFpsOrImageSize) {
+  for (double fps : {1e-320, 0.5, 1e308}) {
+    const std::string message = ErrorAfterEdit(
+        "fps_absurd.json", [fps](json& text) { text["fps"] = fps; });
+    EXPECT_NE(message.find("is outside [1"), std::string::npos) << message;
+  }
+  for (long side : {4294968296L, 100000L, -5L}) {
+    const std::string message = ErrorAfterEdit(
+        "side.json", [side](json& text) { text["image_width_px"] = side; });
+    EXPECT_NE(message.find("image size must be in [1, 65536]"),
+              std::string::npos)
+        << message;
+  }
+}
+
 TEST_F(ClipIoBadInput, ObjectTrackOfWrongLength) {
   std::string message = ErrorAfterEdit(
       "ball.json", [](json& text) { text["objects"][0]["points"].erase(0); });

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "common/error.h"
+#include "common/file_io.h"
 #include "motion/motion_io.h"
 #include "test_paths.h"
 
@@ -183,6 +184,19 @@ TEST(DeepMimicReader, BadFilesNameTheFileAndTheProblem) {
       "{\"Frames\": [[0.0333, 0, 0.85, 0, 0, 0, 0, 0" + joints + "]]}",
       "zero-length quaternion");
   ExpectMotionError("", "malformed JSON");
+}
+
+// Found by fuzzing: "Wrap" (capitalized) was read as not looping.
+TEST(DeepMimicReader, LoopIsReadWithoutCase) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  std::string text = ReadFileText(path);
+  const size_t at = text.find("\"wrap\"");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 6, "\"Wrap\"");
+  const std::string dir = testing::TempDir("deepmimic_loop");
+  const std::string copy = dir + "/walk.txt";
+  WriteFileAtomic(copy, text);
+  EXPECT_TRUE(ReadDeepMimicMotion(copy, Humanoid()).loops);
 }
 
 TEST(DeepMimicReader, MissingFileIsAnInputError) {

@@ -118,6 +118,21 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
       "data: {bundles: [a.json]}\n"
       "agent: {learning_rate_min: 0.01, learning_rate_max: 0.001}\n",
       "learning_rate_min");
+  // Found by fuzzing: these trained to NaN, made 1-frame episodes, or kept
+  // the first of two settings without a word.
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {learning_rate: .inf}\n",
+                    "'agent.learning_rate' must be a finite number");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {clip_ratio: .nan}\n",
+                    "'agent.clip_ratio' must be a finite number");
+  ExpectConfigError("data: {bundles: [a.json]}\nenv: {max_episode_s: .inf}\n",
+                    "'env.max_episode_s' must be a finite number");
+  ExpectConfigError(
+      "data: {bundles: [a.json]}\nagent: {epochs: 3, epochs: 5}\n",
+      "'agent.epochs' appears twice");
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: /dev/null\n",
+                    "not a regular file", false);
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: /tmp\n",
+                    "is a folder, not a file", false);
 }
 
 }  // namespace
