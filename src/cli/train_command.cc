@@ -43,11 +43,12 @@ int RunTrain(const TrainArgs& args) {
       static_cast<long long>(config.run.total_samples));
   std::printf("%s\n", DescribeSources(config.data.sources()).c_str());
   std::printf("BLAS: %s\n", DescribeBlas().c_str());
-  Trainer trainer(config, args.resume);
-
-  // Ctrl-C / kill: finish the iteration, write a checkpoint, exit.
+  // Ctrl-C / kill: finish the iteration, write a checkpoint, exit. Installed
+  // before the (slow) setup, so that a stop during it is not a hard kill.
   std::signal(SIGINT, RequestStop);
   std::signal(SIGTERM, RequestStop);
+  Trainer trainer(config, args.resume);
+
   auto report = [&](const TrainProgress& p) {
     double eta_s =
         (config.run.total_samples - p.samples) / std::max(1.0, p.samples_per_s);

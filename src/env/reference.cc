@@ -5,6 +5,7 @@
 #include <random>
 
 #include "common/error.h"
+#include "common/hash.h"
 #include "motion/canonical.h"
 #include "sim/pose_mapping.h"
 
@@ -263,11 +264,25 @@ std::shared_ptr<const TrackingReference> TrackingReference::Prepare(
   return reference;
 }
 
+uint64_t ReferenceFingerprint(const TrackingReference& reference) {
+  uint64_t hash = kFnv1a64Seed;
+  for (const TrackedView& view : reference.views()) {
+    const int64_t shape[2] = {view.num_frames, view.num_points};
+    hash = Fnv1a64(shape, sizeof(shape), hash);
+    for (const Keypoint2D& point : view.points) {
+      const double values[3] = {point.x_px, point.y_px, point.confidence};
+      hash = Fnv1a64(values, sizeof(values), hash);
+    }
+  }
+  return hash;
+}
+
 InitialStates::InitialStates(const TrackingReference& reference,
                              std::shared_ptr<const Character> character,
                              const SimulationOptions& simulation_options,
                              const StateBufferOptions& options,
                              double joint_noise_rad, uint64_t noise_seed) {
+  reference_fingerprint_ = ReferenceFingerprint(reference);
   // Outline: per buffer (a bundle's, or with an estimate a view's), per
   // frame, put the character in a plausible pose (3D truth, the view's
   // estimate, or a placed default pose), perturb its joints if asked, and

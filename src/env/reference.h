@@ -72,6 +72,11 @@ class TrackingReference {
 // (frames are shared by its views: they show the same motion, in one world
 // frame); from an estimate, one per view (each view's poses are in its own
 // world frame). Mutable by the trainer (ASI), read by envs.
+// A hash of every tracked view's 2D keypoints (coordinates and
+// confidences) and frame counts: two references with equal frame counts but
+// different motion differ.
+uint64_t ReferenceFingerprint(const TrackingReference& reference);
+
 class InitialStates {
  public:
   // Fills each frame as the reference's sources say:
@@ -103,8 +108,12 @@ class InitialStates {
   const StateBuffer& BufferOfView(int view_index) const {
     return buffers_[BufferOf(view_index)];
   }
+  // ReferenceFingerprint of the reference the buffers were filled for: a
+  // checkpoint's buffers are restored only into the same reference.
+  uint64_t reference_fingerprint() const { return reference_fingerprint_; }
 
  private:
+  uint64_t reference_fingerprint_ = 0;
   std::vector<StateBuffer> buffers_;
   std::vector<int> buffer_of_view_;
 };

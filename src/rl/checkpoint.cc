@@ -1,14 +1,17 @@
 #include "rl/checkpoint.h"
 
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <utility>
 
 #include "common/error.h"
 #include "common/file_io.h"
+#include "common/hash.h"
 
 namespace m2d {
 namespace {
@@ -20,15 +23,6 @@ namespace {
 // without the trailer (written before it existed) load unchecked.
 constexpr char kTrailerMagic[8] = {'M', '2', 'D', 'C', 'K', 'S', 'U', 'M'};
 constexpr size_t kTrailerSize = sizeof(kTrailerMagic) + sizeof(uint64_t);
-
-uint64_t Fnv1a64(const char* data, size_t size) {
-  uint64_t hash = 14695981039346656037ull;
-  for (size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<unsigned char>(data[i]);
-    hash *= 1099511628211ull;
-  }
-  return hash;
-}
 
 // A SimState as one row of doubles, in a fixed field order; sizes come from
 // a template state of the same model.
@@ -103,6 +97,10 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
     archive.write(
         "asi_buffers",
         torch::tensor(static_cast<int64_t>(initial_states->num_buffers())));
+    const uint64_t fingerprint = initial_states->reference_fingerprint();
+    int64_t fingerprint_bits = 0;
+    std::memcpy(&fingerprint_bits, &fingerprint, sizeof(fingerprint_bits));
+    archive.write("asi_reference", torch::tensor(fingerprint_bits));
     for (int b = 0; b < initial_states->num_buffers(); ++b) {
       const StateBuffer& buffer = initial_states->buffer(b);
       int64_t entries = 0;
@@ -210,6 +208,67 @@ ObservationLayout ReadCheckpointLayout(const std::string& path,
   return layout;
 }
 
+namespace {
+
+// Reads the tensor `name` (from character `begin` on) of a module archive:
+// "actor.0.weight" is tensor "weight" of archive "0" of archive "actor".
+bool ReadNestedTensor(torch::serialize::InputArchive& archive,
+                      const std::string& name, size_t begin,
+                      torch::Tensor* tensor) {
+  const size_t dot = name.find('.', begin);
+  if (dot == std::string::npos)
+    return archive.try_read(name.substr(begin), *tensor);
+  torch::serialize::InputArchive child;
+  if (!archive.try_read(name.substr(begin, dot - begin), child)) return false;
+  return ReadNestedTensor(child, name, dot + 1, tensor);
+}
+
+// The network in `archive` must be the one `model` is: the observation
+// layout, the action count and every parameter's shape (hidden sizes).
+// A mismatch is a named error before anything is loaded; LibTorch would
+// otherwise replace the tensors and fail later with a backtrace.
+void CheckSameNetwork(const std::string& path,
+                      torch::serialize::InputArchive& archive,
+                      const ActorCritic& model) {
+  torch::Tensor values;
+  archive.read("layout", values);
+  const ObservationLayout& layout = model->layout();
+  const std::pair<const char*, int64_t> fields[] = {
+      {"character bodies", layout.num_bodies},
+      {"objects", layout.num_objects},
+      {"2D points per frame", layout.num_points},
+      {"future frames (env.num_future_frames)", layout.num_future_frames},
+      {"actions", model->action_size()}};
+  for (int i = 0; i < 5; ++i) {
+    const int64_t saved = values[i].item<int64_t>();
+    if (saved != fields[i].second) {
+      throw InputError(path, std::string("was trained with ") +
+                                 std::to_string(saved) + " " + fields[i].first +
+                                 "; this config has " +
+                                 std::to_string(fields[i].second) +
+                                 ": a structural setting changed (start a new "
+                                 "run_dir, or restore the setting)");
+    }
+  }
+  // Each parameter, by its dotted name in the nested module archives that
+  // Module::save writes.
+  torch::serialize::InputArchive model_archive;
+  archive.read("model", model_archive);
+  for (const auto& parameter : model->named_parameters()) {
+    torch::Tensor saved;
+    if (!ReadNestedTensor(model_archive, parameter.key(), 0, &saved) ||
+        saved.sizes() != parameter.value().sizes()) {
+      throw InputError(path, "its network differs from this config's (" +
+                                 parameter.key() +
+                                 ": model.*_hidden or encoder_features "
+                                 "changed); start a new run_dir, or restore "
+                                 "the model settings");
+    }
+  }
+}
+
+}  // namespace
+
 CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
                                   torch::optim::Optimizer* optimizer,
                                   InitialStates* initial_states,
@@ -217,6 +276,7 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
   torch::serialize::InputArchive archive = OpenArchive(path);
   CheckpointCounters counters;
   try {
+    CheckSameNetwork(path, archive, model);
     // A fresh tensor per read: reading into a defined tensor keeps its
     // dtype and reinterprets the bytes (a double read as int64).
     torch::Tensor iteration, samples, wall_time_s;
@@ -265,7 +325,27 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
                       "and default one per bundle): the config's bundles or "
                       "initial_states differ from the checkpoint's");
       }
-      for (int b = 0; b < initial_states->num_buffers(); ++b) {
+      // Buffers filled for another reference (other bundles of the same
+      // length) would start episodes from the wrong motion: keep this
+      // task's fresh buffers instead, and say so.
+      torch::Tensor saved_reference;
+      bool same_reference = true;
+      if (archive.try_read("asi_reference", saved_reference)) {
+        const int64_t bits = saved_reference.item<int64_t>();
+        uint64_t saved_fingerprint = 0;
+        std::memcpy(&saved_fingerprint, &bits, sizeof(bits));
+        same_reference =
+            saved_fingerprint == initial_states->reference_fingerprint();
+      }
+      if (!same_reference) {
+        spdlog::warn(
+            "{}: its initial-state buffers were filled for other reference "
+            "motion (the bundles' 2D differ); starting this task's buffers "
+            "fresh",
+            path);
+      }
+      for (int b = 0; same_reference && b < initial_states->num_buffers();
+           ++b) {
         std::string prefix = "asi_" + std::to_string(b) + "_";
         torch::Tensor states, scores, frames;
         if (!archive.try_read(prefix + "states", states)) continue;
