@@ -135,6 +135,16 @@ void AddRenderCommand(CLI::App& app, CommandRun* run) {
                    "Policy rollout: cameras from truth or estimate (default: "
                    "the checkpoint's config)")
       ->check(CLI::IsMember({"truth", "estimate"}));
+  render
+      ->add_option("--subject-height",
+                   args->replay.render.subject_height_fraction,
+                   "Zoom in on the subject until it fills this share of the "
+                   "frame height (0: the camera's whole image)")
+      ->capture_default_str();
+  render
+      ->add_option("--max-zoom", args->replay.render.max_zoom,
+                   "Largest zoom of that framing")
+      ->capture_default_str();
   render->add_flag("--no-shadows", args->no_shadows,
                    "Skip shadows (faster software rendering)");
   render->callback([run, args] { *run = [args] { return RunRender(*args); }; });

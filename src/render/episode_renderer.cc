@@ -1,5 +1,6 @@
 #include "render/episode_renderer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -36,6 +37,41 @@ std::vector<Keypoint2D> ScaleKeypoints(const std::vector<Keypoint2D>& points,
   return scaled;
 }
 
+// The crop that frames the subject: centre (x, y) of the box around the
+// present points, and the zoom that makes the box `fraction` of the image
+// height (in [1, max_zoom]); nullopt without present points.
+std::optional<Eigen::Vector3d> SubjectFraming(
+    const std::vector<Keypoint2D>& points, int height_px, double fraction,
+    double max_zoom) {
+  Eigen::Vector2d low(1e300, 1e300), high(-1e300, -1e300);
+  int present = 0;
+  for (const Keypoint2D& point : points) {
+    if (!point.IsPresent()) continue;
+    low = low.cwiseMin(point.Pixel());
+    high = high.cwiseMax(point.Pixel());
+    ++present;
+  }
+  if (present < 2) return std::nullopt;
+  const double box_height_px = std::max(high.y() - low.y(), 1.0);
+  const double zoom =
+      std::clamp(fraction * height_px / box_height_px, 1.0, max_zoom);
+  const Eigen::Vector2d centre = 0.5 * (low + high);
+  return Eigen::Vector3d(centre.x(), centre.y(), zoom);
+}
+
+// `points` seen through the crop whose top-left corner is `corner` and
+// magnification `zoom` (CropCamera's map).
+std::vector<Keypoint2D> CropKeypoints(const std::vector<Keypoint2D>& points,
+                                      const Eigen::Vector2d& corner,
+                                      double zoom) {
+  std::vector<Keypoint2D> cropped = points;
+  for (Keypoint2D& point : cropped) {
+    point.x_px = (point.x_px - corner.x()) * zoom;
+    point.y_px = (point.y_px - corner.y()) * zoom;
+  }
+  return cropped;
+}
+
 Eigen::Vector3d MeanPoint(const std::vector<Eigen::Vector3d>& points,
                           const Eigen::Vector3d& fallback) {
   if (points.empty()) return fallback;
@@ -57,6 +93,12 @@ void EpisodeRenderOptions::Validate() const {
     throw ConfigError("render scale must be in (0, 4]");
   }
   if (side_camera) side.Validate();
+  if (!(subject_height_fraction >= 0 && subject_height_fraction <= 1)) {
+    throw ConfigError("render: subject_height_fraction must be in [0, 1]");
+  }
+  if (!(max_zoom >= 1 && max_zoom <= 20)) {
+    throw ConfigError("render: max_zoom must be in [1, 20]");
+  }
 }
 
 void EpisodeOutputOptions::Validate() const {
@@ -152,11 +194,7 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
                                    " 3D keypoints, layout " + layout_->name +
                                    " has " + std::to_string(num_keypoints));
   }
-  const PinholeCamera camera = ScaleCamera(frame.camera, options_.scale);
-  RenderedFrame rendered;
-  rendered.image = scene_->RenderPinhole(simulation_.mutable_data(), camera);
-
-  // The pose's projection in clip pixels, for the error, and scaled.
+  // The pose's projection in clip pixels, for the error and the framing.
   std::vector<Keypoint2D> pose_px(pose_world_m.size());
   std::vector<double> projected_xy(2 * pose_world_m.size());
   auto in_front = std::make_unique<bool[]>(pose_world_m.size() + 1);
@@ -168,6 +206,41 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
     pose_px[j] = {projection.pixel_px.x(), projection.pixel_px.y(),
                   projection.in_front ? 1.0 : 0.0};
   }
+
+  // Framing: follow the subject (the reference, else the pose) with a crop
+  // that moves and zooms smoothly, kept inside the image.
+  Eigen::Vector2d corner(0.0, 0.0);
+  double zoom = 1.0;
+  if (options_.subject_height_fraction > 0) {
+    std::optional<Eigen::Vector3d> target =
+        SubjectFraming(frame.reference, image_height_px_,
+                       options_.subject_height_fraction, options_.max_zoom);
+    if (!target) {
+      target =
+          SubjectFraming(pose_px, image_height_px_,
+                         options_.subject_height_fraction, options_.max_zoom);
+    }
+    constexpr double kFollow = 0.15;  // per frame: about a 0.2 s lag at 30 Hz
+    if (target) {
+      framing_ =
+          framing_ ? (1.0 - kFollow) * *framing_ + kFollow * *target : *target;
+    }
+    if (framing_) {
+      zoom = (*framing_)[2];
+      const Eigen::Vector2d window(image_width_px_ / zoom,
+                                   image_height_px_ / zoom);
+      corner = framing_->head<2>() - 0.5 * window;
+      corner.x() = std::clamp(corner.x(), 0.0, image_width_px_ - window.x());
+      corner.y() = std::clamp(corner.y(), 0.0, image_height_px_ - window.y());
+    }
+  }
+  const PinholeCamera camera = ScaleCamera(
+      CropCamera(frame.camera, corner.x(), corner.y(), zoom), options_.scale);
+  RenderedFrame rendered;
+  rendered.image = scene_->RenderPinhole(simulation_.mutable_data(), camera);
+  rendered.crop_corner_px = corner;
+  rendered.zoom = zoom;
+
   if (!pose_world_m.empty() && !frame.reference.empty()) {
     const ReprojectionError error =
         MeasureReprojection(projected_xy.data(), in_front.get(),
@@ -182,10 +255,15 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
   reference_sizes.line_width_px *= 2.2;
   reference_sizes.dot_radius_px *= 1.6;
   OverlayCanvas canvas(&rendered.image);
-  canvas.DrawSkeleton(*layout_, ScaleKeypoints(frame.reference, options_.scale),
-                      options_.reference_color, reference_sizes);
-  canvas.DrawSkeleton(*layout_, ScaleKeypoints(pose_px, options_.scale),
-                      options_.pose_color, sizes);
+  canvas.DrawSkeleton(
+      *layout_,
+      ScaleKeypoints(CropKeypoints(frame.reference, corner, zoom),
+                     options_.scale),
+      options_.reference_color, reference_sizes);
+  canvas.DrawSkeleton(
+      *layout_,
+      ScaleKeypoints(CropKeypoints(pose_px, corner, zoom), options_.scale),
+      options_.pose_color, sizes);
   const double margin_px = 0.5 * sizes.font_size_px;
   canvas.DrawLabel({{"frame " + std::to_string(frame.clip_frame)},
                     {FormatE2d(rendered.e2d_px)},

@@ -69,6 +69,12 @@ struct EpisodeRenderOptions {
   bool side_camera = false;
   OrbitCameraOptions side;
   bool shadows = true;
+  // Framing: the view zooms in on the subject (a crop of the reference
+  // camera, drawn at full resolution) so that it fills about this share of
+  // the frame height, following it smoothly; at most `max_zoom`x, never
+  // out. 0 shows the camera's whole image.
+  double subject_height_fraction = 0.5;
+  double max_zoom = 3.0;
   Rgb reference_color = {40, 200, 70};  // green: the 2D reference
   Rgb pose_color = {230, 50, 40};       // red: the shown pose, projected
   std::string reference_label = "2D reference";
@@ -82,6 +88,10 @@ struct RenderedFrame {
   // Mean distance (clip pixels) between the reference and the projected
   // pose over the reference's present keypoints; NaN when not measurable.
   double e2d_px = std::numeric_limits<double>::quiet_NaN();
+  // The framing crop shown (EpisodeRenderOptions::subject_height_fraction):
+  // clip pixel p is drawn at (p - crop_corner_px) x zoom x scale.
+  Eigen::Vector2d crop_corner_px = Eigen::Vector2d::Zero();
+  double zoom = 1.0;
 };
 
 // Draws episode frames: the 3D scene through the frame's pinhole camera,
@@ -99,6 +109,9 @@ class EpisodeRenderer {
                   int image_height_px, const EpisodeRenderOptions& options);
 
   RenderedFrame Render(const EpisodeFrame& frame);
+  // Forget the framing (the next frame is framed on its own, not smoothed
+  // from the previous one): call between episodes.
+  void ResetFraming() { framing_.reset(); }
 
   // Output frame size (both panels).
   int width_px() const;
@@ -118,6 +131,8 @@ class EpisodeRenderer {
   int panel_width_px_;  // one panel of the output, after scaling
   int panel_height_px_;
   std::unique_ptr<SceneRenderer> scene_;
+  // The smoothed crop (centre x, y in clip pixels; zoom), once framed.
+  std::optional<Eigen::Vector3d> framing_;
 };
 
 // What to write and which frames.

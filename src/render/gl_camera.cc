@@ -67,6 +67,21 @@ PinholeCamera ScaleCamera(const PinholeCamera& camera, double scale) {
                        camera.translation_m());
 }
 
+PinholeCamera CropCamera(const PinholeCamera& camera, double x0_px,
+                         double y0_px, double zoom) {
+  if (!(std::isfinite(zoom) && zoom > 0 && std::isfinite(x0_px) &&
+        std::isfinite(y0_px))) {
+    throw ConfigError("crop: zoom must be positive and the corner finite");
+  }
+  Intrinsics k = camera.intrinsics();
+  k.fx_px *= zoom;
+  k.fy_px *= zoom;
+  k.cx_px = (k.cx_px - x0_px) * zoom;
+  k.cy_px = (k.cy_px - y0_px) * zoom;
+  return PinholeCamera(k, camera.rotation_world_to_camera(),
+                       camera.translation_m());
+}
+
 void OrbitCameraOptions::Validate() const {
   if (!(std::isfinite(azimuth_deg) && std::isfinite(elevation_deg))) {
     throw ConfigError("orbit camera: azimuth and elevation must be finite");

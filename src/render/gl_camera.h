@@ -31,6 +31,14 @@ mjvGLCamera GlCameraFromPinhole(const PinholeCamera& camera, double near_m,
 // extra view on the right or bottom but is never stretched.
 PinholeCamera ScaleCamera(const PinholeCamera& camera, double scale);
 
+// A window of `camera`'s image magnified to the whole image: the window's
+// top-left corner at (x0_px, y0_px), its size the image's / `zoom`. The
+// same camera centre and orientation (a digital zoom that loses no
+// resolution, since the scene is drawn again); pixel p of `camera` lands
+// at (p - (x0, y0)) x zoom.
+PinholeCamera CropCamera(const PinholeCamera& camera, double x0_px,
+                         double y0_px, double zoom);
+
 // A camera orbiting a point, placed like MuJoCo's free camera: it looks
 // along (cos el cos az, cos el sin az, sin el) from `distance_m` away.
 struct OrbitCameraOptions {

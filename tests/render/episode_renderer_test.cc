@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -84,6 +85,46 @@ TEST_F(EpisodeFrameTest, OverlaysLandOnTheProjectedAndReferencePixels) {
                              static_cast<int>(std::floor(0.5 * point.y_px))),
               options.reference_color);
   }
+}
+
+// A subject far from the camera: the view zooms in until it fills half
+// the frame height, and the overlays follow the crop.
+TEST_F(EpisodeFrameTest, FramingZoomsInOnASmallSubject) {
+  const Eigen::Vector3d center = testing::Centroid(keypoints_m_);
+  Intrinsics intrinsics = camera_.intrinsics();
+  camera_ = PinholeCamera::LookAt(
+      intrinsics, center + Eigen::Vector3d(9.0, 4.5, 1.2), center);
+  EpisodeRenderOptions options;
+  options.scale = 0.5;
+  options.subject_height_fraction = 0.5;
+  EpisodeRenderer renderer(character_, SimulationOptions(),
+                           character_->keypoint_layout(), 640, 480, options);
+  EpisodeFrame frame;
+  frame.camera = camera_;
+  frame.state = state_;
+  frame.reference = Projected(0.0);
+  const RenderedFrame rendered = renderer.Render(frame);
+  EXPECT_GT(rendered.zoom, 1.5);
+  EXPECT_NEAR(rendered.e2d_px, 0.0, 1e-9);  // measured in clip pixels
+  double top = 1e9, bottom = -1e9;
+  for (const Keypoint2D& point : frame.reference) {
+    const Eigen::Vector2d shown =
+        (point.Pixel() - rendered.crop_corner_px) * rendered.zoom * 0.5;
+    top = std::min(top, shown.y());
+    bottom = std::max(bottom, shown.y());
+    ASSERT_GE(shown.x(), 0);
+    ASSERT_LT(shown.x(), 320);
+    EXPECT_EQ(rendered.image.at(static_cast<int>(std::floor(shown.x())),
+                                static_cast<int>(std::floor(shown.y()))),
+              options.pose_color);
+  }
+  EXPECT_NEAR((bottom - top) / 240.0, 0.5, 1e-6);
+
+  // Framing off: the camera's whole image.
+  options.subject_height_fraction = 0.0;
+  EpisodeRenderer whole(character_, SimulationOptions(),
+                        character_->keypoint_layout(), 640, 480, options);
+  EXPECT_EQ(whole.Render(frame).zoom, 1.0);
 }
 
 TEST_F(EpisodeFrameTest, SideCameraDoublesTheWidth) {

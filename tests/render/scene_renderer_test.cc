@@ -137,7 +137,11 @@ TEST_F(KnownPoseRender, CenteredFrustumWouldMissTheKeypoints) {
   renderer_->SetHiddenBodies({});
   const RgbImage scene =
       renderer_->RenderPinhole(simulation_->mutable_data(), wrong);
-  const RgbImage empty = Render(false);
+  // The empty scene through the same wrong camera: only the character
+  // differs (the checker floor is seen from the same place).
+  renderer_->SetHiddenBodies(character_->bodies());
+  const RgbImage empty =
+      renderer_->RenderPinhole(simulation_->mutable_data(), wrong);
   int missed = 0;
   for (const Eigen::Vector3d& keypoint : keypoints_m_) {
     missed += DistanceToCharacterPx(scene, empty,
