@@ -191,6 +191,8 @@ EvalTable ReadEvalTable(const std::string& json_path) {
     if (!row.value().is_object()) row.Fail("expected an object");
     for (const auto& item : row.value().items()) {
       const std::string& key = item.key();
+      // Nested detail (eval's per-rollout list) is not a table cell.
+      if (item.value().is_structured()) continue;
       const bool known =
           std::find(std::begin(kKnownEvalColumns), std::end(kKnownEvalColumns),
                     key) != std::end(kKnownEvalColumns);

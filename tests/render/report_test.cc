@@ -18,7 +18,7 @@ constexpr char kEval[] = R"({"rows": [
   {"clip": "walk", "view": "cam0", "succ": 1.0, "e2d_px": 4.25,
    "e3d_mm": 61.5, "jitter": 0.0123},
   {"view": "cam1", "clip": "walk <b>", "succ": false, "e2d_px": null,
-   "notes": "fell"}
+   "notes": "fell", "rollouts": [{"start_frame": 0, "frames": 3}]}
 ]})";
 
 struct ReportFiles {
@@ -61,6 +61,7 @@ std::string Base64Decode(const std::string& text) {
   return decoded;
 }
 
+// (Nested detail such as eval's per-rollout list is not a column.)
 TEST(EvalTable, KnownColumnsFirstThenTheRest) {
   const ReportFiles files = MakeFiles("eval_table");
   const EvalTable table = ReadEvalTable(files.eval);
