@@ -30,6 +30,7 @@ struct BenchFitArgs {
   std::string config;  // FitOptions YAML; "": the defaults
   std::vector<std::string> settings;  // names; empty: all
   std::string noise = "both";         // clean, noisy or both
+  bool markdown = false;              // also print the table as Markdown
   bool quick = false;
 };
 
@@ -95,6 +96,8 @@ int RunBenchFit(const BenchFitArgs& args) {
 
   const FitBenchmarkResult result = RunFitBenchmark(*character, options);
   std::printf("\n%s", FormatFitBenchmarkTable(result).c_str());
+  if (args.markdown)
+    std::printf("\n%s", FormatFitBenchmarkMarkdown(result).c_str());
   std::printf(
       "(per row: mean over its views; errors are absolute; MPJPEroot after "
       "the best rotation about z; %d of %d fits returned; %.0f s in all)\n",
@@ -149,6 +152,8 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
       fit->add_option("--noise", args->noise, "clean, noisy or both")
           ->check(CLI::IsMember({"clean", "noisy", "both"}))
           ->capture_default_str();
+  fit->add_flag("--markdown", args->markdown,
+                "Also print the table as Markdown (for docs/fit.md)");
   fit->add_flag("--quick", args->quick,
                 "Only the walk, clean 2D, setting A, one view (a smoke test)")
       ->excludes(clips)
