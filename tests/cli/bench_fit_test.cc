@@ -52,7 +52,7 @@ TEST(CliBenchFit, QuickPrintsARowOfFiniteFigures) {
   EXPECT_NE(result.output.find("[1/1] walk, setting A, clean, view 1/1"),
             std::string::npos)
       << result.output;
-  // "walk A clean 1/1 <frames> <9 figures>"
+  // "walk A clean 1/1 <frames> <10 figures>"
   const std::string row = LineStartingWith(result.output, "walk ");
   ASSERT_FALSE(row.empty()) << result.output;
   std::istringstream fields(row);
@@ -71,7 +71,7 @@ TEST(CliBenchFit, QuickPrintsARowOfFiniteFigures) {
     EXPECT_GE(value, 0.0) << row;
     ++figures;
   }
-  EXPECT_EQ(figures, 9) << row;
+  EXPECT_EQ(figures, 10) << row;
   EXPECT_FALSE(LineStartingWith(result.output, "all ").empty())
       << result.output;
 

@@ -120,7 +120,8 @@ class BadConfigTest : public ::testing::Test {
          {"characters/humanoid.yaml", "characters/humanoid.xml",
           "characters/soccer_ball.xml", "scenes/humanoid_flat.xml",
           "scenes/humanoid_ball.xml", "scenes/humanoid_floating.xml",
-          "skeletons/humanoid.yaml", "skeletons/humanoid.coco17.yaml"}) {
+          "scenes/look.xml", "skeletons/humanoid.yaml",
+          "skeletons/humanoid.coco17.yaml"}) {
       std::filesystem::copy_file(SourcePath(std::string("assets/") + file),
                                  dir_ + "/" + file);
     }
