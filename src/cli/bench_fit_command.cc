@@ -27,7 +27,7 @@ struct BenchFitArgs {
   int threads = 1;
   std::string output;  // JSON; empty: none
   std::string motion_dir;
-  std::string config;  // FitOptions YAML; "": the defaults
+  std::string config;                 // FitOptions YAML; "": the defaults
   std::vector<std::string> settings;  // names; empty: all
   std::string noise = "both";         // clean, noisy or both
   bool markdown = false;              // also print the table as Markdown

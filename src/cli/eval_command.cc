@@ -17,6 +17,7 @@ struct EvalArgs {
   EvalOptions options;
   std::string starts;   // "": the checkpoint's config
   std::string cameras;  // "": the checkpoint's config
+  bool asi_starts = false;
 };
 
 int RunEval(const EvalArgs& args) {
@@ -24,9 +25,9 @@ int RunEval(const EvalArgs& args) {
   if (!args.starts.empty())
     sources.initial_states = ParseInitialStateSource(args.starts);
   if (!args.cameras.empty()) sources.cameras = ParseCameraSource(args.cameras);
-  CheckpointEvaluation evaluation =
-      EvaluateCheckpoint(args.checkpoint, args.bundles, args.options, sources,
-                         args.truth_bundles);
+  sources.checkpoint_buffers = args.asi_starts;
+  CheckpointEvaluation evaluation = EvaluateCheckpoint(
+      args.checkpoint, args.bundles, args.options, sources, args.truth_bundles);
   PrintEvalTable(evaluation);
   if (!args.output.empty()) {
     WriteEvalJson(args.output, args.checkpoint, args.options, evaluation);
@@ -69,6 +70,10 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
                    "Cameras from: truth or estimate (default: the "
                    "checkpoint's config)")
       ->check(CLI::IsMember({"truth", "estimate"}));
+  eval->add_flag("--asi-starts", args->asi_starts,
+                 "Start episodes from the checkpoint's ASI buffers (the "
+                 "starts as training refined them) instead of fresh ones; "
+                 "needs the training's sources and bundles");
   eval->add_option("-o,--output", args->output, "Write the table as JSON here");
   eval->callback([run, args] { *run = [args] { return RunEval(*args); }; });
 }

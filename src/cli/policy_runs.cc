@@ -9,6 +9,7 @@
 #include "env/task.h"
 #include "motion/bundle.h"
 #include "render/policy_rollout.h"
+#include "rl/checkpoint.h"
 #include "rl/torch_policy.h"
 
 namespace m2d::cli {
@@ -109,6 +110,12 @@ CheckpointEvaluation EvaluateCheckpoint(
   evaluation.sources = task_options.sources;
   TrackingTask task = BuildTrackingTask(TrainedCharacterPath(config),
                                         config.data.scene, paths, task_options);
+  evaluation.checkpoint_buffers = sources.checkpoint_buffers;
+  if (sources.checkpoint_buffers) {
+    Simulation simulation(task.character, config.env.simulation);
+    LoadCheckpointStateBuffers(checkpoint, task.initial_states.get(),
+                               simulation.Save());
+  }
   // Measurement only: the truth, read again from the files, goes to the
   // evaluator and never into the task the policy runs in.
   if (!truth_paths.empty() && truth_paths.size() != paths.size()) {
@@ -144,6 +151,11 @@ CheckpointEvaluation EvaluateCheckpoint(
 
 void PrintEvalTable(const CheckpointEvaluation& evaluation) {
   std::printf("%s\n", DescribeSources(evaluation.sources).c_str());
+  if (evaluation.checkpoint_buffers) {
+    std::printf(
+        "episodes start from the checkpoint's ASI buffers: those states as "
+        "training refined them in simulation (no 3D truth)\n");
+  }
   if (evaluation.sources.cameras == CameraSource::kEstimate) {
     std::printf(
         "E3D against the hidden truth: global not measured (each view's "
@@ -165,6 +177,7 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
       {"checkpoint", checkpoint},
       {"starts", SourceName(evaluation.sources.initial_states)},
       {"cameras", SourceName(evaluation.sources.cameras)},
+      {"starts_from_checkpoint_buffers", evaluation.checkpoint_buffers},
       {"episode_s", options.episode_s},
       {"success_threshold_px", options.success_threshold_px},
       {"rows", nlohmann::json::array()},

@@ -20,10 +20,14 @@ namespace m2d::cli {
 struct SourceOverrides {
   std::optional<InitialStateSource> initial_states;  // eval --starts
   std::optional<CameraSource> cameras;               // eval --cameras
+  // eval --asi-starts: the starts' buffers as training left them (the
+  // sources' states refined by ASI), read from the checkpoint.
+  bool checkpoint_buffers = false;
 };
 
 struct CheckpointEvaluation {
-  TaskSources sources;  // the ones the rollouts used
+  TaskSources sources;              // the ones the rollouts used
+  bool checkpoint_buffers = false;  // starts from the checkpoint's buffers
   std::vector<EvalRow> rows;
 };
 

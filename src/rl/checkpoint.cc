@@ -267,6 +267,76 @@ void CheckSameNetwork(const std::string& path,
   }
 }
 
+// Restores the ASI buffers saved in `archive` into `initial_states` (see
+// LoadCheckpoint). Throws c10::Error on malformed tensors.
+void RestoreStateBuffers(const std::string& path,
+                         torch::serialize::InputArchive& archive,
+                         InitialStates* initial_states,
+                         const SimState& state_template) {
+  const int64_t width = FlatStateSize(state_template);
+  // The buffers must be this task's: one per bundle (truth, default
+  // starts) or one per view (estimate).
+  torch::Tensor saved_buffers;
+  int64_t num_saved = 0;
+  if (archive.try_read("asi_buffers", saved_buffers)) {
+    num_saved = saved_buffers.item<int64_t>();
+  } else {  // older checkpoints: count the buffers present
+    torch::Tensor probe;
+    while (
+        archive.try_read("asi_" + std::to_string(num_saved) + "_states", probe))
+      ++num_saved;
+  }
+  if (num_saved > 0 && num_saved != initial_states->num_buffers()) {
+    throw InputError(path,
+                     "holds " + std::to_string(num_saved) +
+                         " initial-state buffers but this task has " +
+                         std::to_string(initial_states->num_buffers()) +
+                         " (initial_states: estimate keeps one per view, truth "
+                         "and default one per bundle): the config's bundles or "
+                         "initial_states differ from the checkpoint's");
+  }
+  // Buffers filled for another reference (other bundles of the same
+  // length) would start episodes from the wrong motion: keep this
+  // task's fresh buffers instead, and say so.
+  torch::Tensor saved_reference;
+  bool same_reference = true;
+  if (archive.try_read("asi_reference", saved_reference)) {
+    const int64_t bits = saved_reference.item<int64_t>();
+    uint64_t saved_fingerprint = 0;
+    std::memcpy(&saved_fingerprint, &bits, sizeof(bits));
+    same_reference =
+        saved_fingerprint == initial_states->reference_fingerprint();
+  }
+  if (!same_reference) {
+    spdlog::warn(
+        "{}: its initial-state buffers were filled for other reference "
+        "motion (the bundles' 2D differ); starting this task's buffers "
+        "fresh",
+        path);
+  }
+  for (int b = 0; same_reference && b < initial_states->num_buffers(); ++b) {
+    std::string prefix = "asi_" + std::to_string(b) + "_";
+    torch::Tensor states, scores, frames;
+    if (!archive.try_read(prefix + "states", states)) continue;
+    archive.read(prefix + "scores", scores);
+    archive.read(prefix + "frames", frames);
+    if (states.size(1) != width)
+      throw InputError(path, "ASI states do not fit this model");
+    StateBuffer& buffer = initial_states->buffer(b);
+    StateBuffer restored(buffer.num_frames(),
+                         StateBufferOptions(buffer.options()));
+    SimState state;
+    for (int64_t row = 0; row < states.size(0); ++row) {
+      int frame = static_cast<int>(frames[row].item<int64_t>());
+      if (frame < 0 || frame >= buffer.num_frames())
+        throw InputError(path, "ASI frame out of range");
+      UnflattenState(states[row].data_ptr<double>(), state_template, &state);
+      restored.Insert(frame, state, scores[row].item<double>());
+    }
+    buffer = std::move(restored);
+  }
+}
+
 }  // namespace
 
 CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
@@ -302,77 +372,46 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
           group.options().set_lr(counters.learning_rate);
       }
     }
-    if (initial_states != nullptr) {
-      const int64_t width = FlatStateSize(state_template);
-      // The buffers must be this task's: one per bundle (truth, default
-      // starts) or one per view (estimate).
-      torch::Tensor saved_buffers;
-      int64_t num_saved = 0;
-      if (archive.try_read("asi_buffers", saved_buffers)) {
-        num_saved = saved_buffers.item<int64_t>();
-      } else {  // older checkpoints: count the buffers present
-        torch::Tensor probe;
-        while (archive.try_read("asi_" + std::to_string(num_saved) + "_states",
-                                probe))
-          ++num_saved;
-      }
-      if (num_saved > 0 && num_saved != initial_states->num_buffers()) {
-        throw InputError(
-            path, "holds " + std::to_string(num_saved) +
-                      " initial-state buffers but this task has " +
-                      std::to_string(initial_states->num_buffers()) +
-                      " (initial_states: estimate keeps one per view, truth "
-                      "and default one per bundle): the config's bundles or "
-                      "initial_states differ from the checkpoint's");
-      }
-      // Buffers filled for another reference (other bundles of the same
-      // length) would start episodes from the wrong motion: keep this
-      // task's fresh buffers instead, and say so.
-      torch::Tensor saved_reference;
-      bool same_reference = true;
-      if (archive.try_read("asi_reference", saved_reference)) {
-        const int64_t bits = saved_reference.item<int64_t>();
-        uint64_t saved_fingerprint = 0;
-        std::memcpy(&saved_fingerprint, &bits, sizeof(bits));
-        same_reference =
-            saved_fingerprint == initial_states->reference_fingerprint();
-      }
-      if (!same_reference) {
-        spdlog::warn(
-            "{}: its initial-state buffers were filled for other reference "
-            "motion (the bundles' 2D differ); starting this task's buffers "
-            "fresh",
-            path);
-      }
-      for (int b = 0; same_reference && b < initial_states->num_buffers();
-           ++b) {
-        std::string prefix = "asi_" + std::to_string(b) + "_";
-        torch::Tensor states, scores, frames;
-        if (!archive.try_read(prefix + "states", states)) continue;
-        archive.read(prefix + "scores", scores);
-        archive.read(prefix + "frames", frames);
-        if (states.size(1) != width)
-          throw InputError(path, "ASI states do not fit this model");
-        StateBuffer& buffer = initial_states->buffer(b);
-        StateBuffer restored(buffer.num_frames(),
-                             StateBufferOptions(buffer.options()));
-        SimState state;
-        for (int64_t row = 0; row < states.size(0); ++row) {
-          int frame = static_cast<int>(frames[row].item<int64_t>());
-          if (frame < 0 || frame >= buffer.num_frames())
-            throw InputError(path, "ASI frame out of range");
-          UnflattenState(states[row].data_ptr<double>(), state_template,
-                         &state);
-          restored.Insert(frame, state, scores[row].item<double>());
-        }
-        buffer = std::move(restored);
-      }
-    }
+    if (initial_states != nullptr)
+      RestoreStateBuffers(path, archive, initial_states, state_template);
   } catch (const c10::Error& e) {
     throw InputError(path, "checkpoint does not match this config (" +
                                std::string(e.what_without_backtrace()) + ")");
   }
   return counters;
+}
+
+void LoadCheckpointStateBuffers(const std::string& path,
+                                InitialStates* initial_states,
+                                const SimState& state_template) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  torch::Tensor saved_buffers;
+  if (!archive.try_read("asi_buffers", saved_buffers)) {
+    throw InputError(path, "holds no initial-state buffers");
+  }
+  // Only buffers known to belong to this reference: a checkpoint from
+  // before fingerprints cannot say which motion its buffers are of.
+  torch::Tensor saved_reference;
+  if (!archive.try_read("asi_reference", saved_reference)) {
+    throw InputError(path,
+                     "its initial-state buffers carry no reference "
+                     "fingerprint (an older checkpoint): cannot tell which "
+                     "motion they belong to");
+  }
+  const int64_t bits = saved_reference.item<int64_t>();
+  uint64_t fingerprint = 0;
+  std::memcpy(&fingerprint, &bits, sizeof(bits));
+  if (fingerprint != initial_states->reference_fingerprint()) {
+    throw InputError(path,
+                     "its initial-state buffers were filled for other "
+                     "reference motion than these bundles'");
+  }
+  try {
+    RestoreStateBuffers(path, archive, initial_states, state_template);
+  } catch (const c10::Error& e) {
+    throw InputError(path, "initial-state buffers do not fit this task (" +
+                               std::string(e.what_without_backtrace()) + ")");
+  }
 }
 
 }  // namespace m2d

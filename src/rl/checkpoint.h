@@ -45,6 +45,14 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
                                   InitialStates* initial_states,
                                   const SimState& state_template);
 
+// Restores only the ASI buffers of `path` into `initial_states` (a task
+// built with the checkpoint's sources on the same reference): episodes then
+// start from the states training refined. InputError when the checkpoint
+// has none or they belong to another task.
+void LoadCheckpointStateBuffers(const std::string& path,
+                                InitialStates* initial_states,
+                                const SimState& state_template);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_RL_CHECKPOINT_H_

@@ -206,6 +206,11 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("give one per --bundle"), std::string::npos)
       << result.output;
+  // --asi-starts needs buffers known to belong to these bundles; the
+  // committed walk checkpoint predates the fingerprint.
+  ExpectInputError("eval " + policy + " --bundle " + full +
+                       " --asi-starts --episodes 1 --episode-s 0.3",
+                   policy, "initial-state buffers");
   // Truth sources on the stripped file: a named error, not a crash.
   ExpectInputError(
       "eval " + policy + " --bundle " + fitted_path + " --episodes 1",

@@ -391,6 +391,32 @@ TEST(Resume, BuffersOfAnotherReferenceAreNotReused) {
     return task.initial_states;
   };
   const auto same = buffers_for(config);
+  // Only the buffers (eval --asi-starts): restored into the same reference,
+  // refused for another.
+  {
+    TrackingTask task =
+        BuildTrackingTask(config.data.character_config, config.data.scene,
+                          config.data.bundles, TrainingTaskOptions(config));
+    TrackingEnv env(task.character, task.reference, task.initial_states,
+                    config.env, 0);
+    LoadCheckpointStateBuffers(checkpoint, task.initial_states.get(),
+                               env.simulation().Save());
+    for (int f = 0; f < same->buffer(0).num_frames(); ++f) {
+      ASSERT_EQ(task.initial_states->buffer(0).size(f),
+                same->buffer(0).size(f));
+      for (int i = 0; i < same->buffer(0).size(f); ++i) {
+        EXPECT_EQ(task.initial_states->buffer(0).entry(f, i).state.qpos,
+                  same->buffer(0).entry(f, i).state.qpos);
+      }
+    }
+    TrackingTask other_task =
+        BuildTrackingTask(other.data.character_config, other.data.scene,
+                          other.data.bundles, TrainingTaskOptions(other));
+    EXPECT_THROW(
+        LoadCheckpointStateBuffers(checkpoint, other_task.initial_states.get(),
+                                   env.simulation().Save()),
+        InputError);
+  }
   const auto fresh_task =
       BuildTrackingTask(other.data.character_config, other.data.scene,
                         other.data.bundles, TrainingTaskOptions(other));
