@@ -88,15 +88,29 @@ std::string RunWalkPolicy(const DemoArgs& args) {
   WriteEvalJson(args.output_dir + "/walk_eval.json", args.walk_policy, eval,
                 evaluation);
 
+  // The video shows the longest evaluated rollout (a failed one when no
+  // rollout succeeded: the video then shows where it fails).
+  std::string view = fitted.views[0].name;
+  int start_frame = 0, longest = -1;
+  for (const EvalRow& row : evaluation.rows) {
+    for (const EvalRollout& rollout : row.rollouts) {
+      if (rollout.frames > longest) {
+        longest = rollout.frames;
+        view = row.view;
+        start_frame = rollout.start_frame;
+      }
+    }
+  }
   BundleReplayOptions replay;
   replay.character_config = AssetPath("characters/humanoid.yaml");
-  replay.view = fitted.views[1 % fitted.views.size()].name;  // a side view
+  replay.view = view;
   replay.render.scale = 0.5;
   replay.render.pose_label = "character (policy)";
   replay.output.video_path = args.output_dir + "/walk_policy.mp4";
+  std::cout << "  video: " << view << " from frame " << start_frame << "\n";
   EpisodeSummary video =
-      RenderCheckpointRollout(args.walk_policy, fitted, replay,
-                              /*start_frame=*/0, eval.episode_s, sources);
+      RenderCheckpointRollout(args.walk_policy, fitted, replay, start_frame,
+                              eval.episode_s, sources);
   return video.video_path;
 }
 
