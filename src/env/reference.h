@@ -68,15 +68,15 @@ class TrackingReference {
   std::vector<int> object_bodies_;
 };
 
+// A hash of every tracked view's 2D keypoints (coordinates and
+// confidences) and frame counts: two references with equal frame counts but
+// different motion differ. Reads the 2D only.
+uint64_t ReferenceFingerprint(const TrackingReference& reference);
+
 // Initial-state buffers. From the truth or the default pose, one per bundle
 // (frames are shared by its views: they show the same motion, in one world
 // frame); from an estimate, one per view (each view's poses are in its own
 // world frame). Mutable by the trainer (ASI), read by envs.
-// A hash of every tracked view's 2D keypoints (coordinates and
-// confidences) and frame counts: two references with equal frame counts but
-// different motion differ.
-uint64_t ReferenceFingerprint(const TrackingReference& reference);
-
 class InitialStates {
  public:
   // Fills each frame as the reference's sources say:

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -267,6 +268,18 @@ void CheckSameNetwork(const std::string& path,
   }
 }
 
+// The reference fingerprint the buffers in `archive` were filled for
+// (stored as an int64 tensor's bits); nullopt in older checkpoints.
+std::optional<uint64_t> SavedReferenceFingerprint(
+    torch::serialize::InputArchive& archive) {
+  torch::Tensor saved;
+  if (!archive.try_read("asi_reference", saved)) return std::nullopt;
+  const int64_t bits = saved.item<int64_t>();
+  uint64_t fingerprint = 0;
+  std::memcpy(&fingerprint, &bits, sizeof(bits));
+  return fingerprint;
+}
+
 // Restores the ASI buffers saved in `archive` into `initial_states` (see
 // LoadCheckpoint). Throws c10::Error on malformed tensors.
 void RestoreStateBuffers(const std::string& path,
@@ -298,15 +311,11 @@ void RestoreStateBuffers(const std::string& path,
   // Buffers filled for another reference (other bundles of the same
   // length) would start episodes from the wrong motion: keep this
   // task's fresh buffers instead, and say so.
-  torch::Tensor saved_reference;
-  bool same_reference = true;
-  if (archive.try_read("asi_reference", saved_reference)) {
-    const int64_t bits = saved_reference.item<int64_t>();
-    uint64_t saved_fingerprint = 0;
-    std::memcpy(&saved_fingerprint, &bits, sizeof(bits));
-    same_reference =
-        saved_fingerprint == initial_states->reference_fingerprint();
-  }
+  const std::optional<uint64_t> saved_fingerprint =
+      SavedReferenceFingerprint(archive);
+  const bool same_reference =
+      !saved_fingerprint ||
+      *saved_fingerprint == initial_states->reference_fingerprint();
   if (!same_reference) {
     spdlog::warn(
         "{}: its initial-state buffers were filled for other reference "
@@ -391,17 +400,15 @@ void LoadCheckpointStateBuffers(const std::string& path,
   }
   // Only buffers known to belong to this reference: a checkpoint from
   // before fingerprints cannot say which motion its buffers are of.
-  torch::Tensor saved_reference;
-  if (!archive.try_read("asi_reference", saved_reference)) {
+  const std::optional<uint64_t> fingerprint =
+      SavedReferenceFingerprint(archive);
+  if (!fingerprint) {
     throw InputError(path,
                      "its initial-state buffers carry no reference "
                      "fingerprint (an older checkpoint): cannot tell which "
                      "motion they belong to");
   }
-  const int64_t bits = saved_reference.item<int64_t>();
-  uint64_t fingerprint = 0;
-  std::memcpy(&fingerprint, &bits, sizeof(bits));
-  if (fingerprint != initial_states->reference_fingerprint()) {
+  if (*fingerprint != initial_states->reference_fingerprint()) {
     throw InputError(path,
                      "its initial-state buffers were filled for other "
                      "reference motion than these bundles'");
