@@ -343,7 +343,9 @@ InitialStates::InitialStates(const TrackingReference& reference,
       }
       if (joint_noise_rad > 0)
         AddJointNoise(joint_noise_rad, noise_rng, simulation);
-      buffer.Insert(t, simulation.Save(), 0.0);
+      const SimState filled = simulation.Save();
+      buffer.Insert(t, filled, 0.0);
+      buffer.SetAnchor(t, filled);
     }
     buffers_.push_back(std::move(buffer));
   }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "common/error.h"
 
@@ -13,10 +15,15 @@ void StateBufferOptions::Validate() const {
   }
   if (!(temperature > 0))
     throw ConfigError("state buffer: temperature must be > 0");
+  if (!(anchor_share >= 0 && anchor_share <= 1))
+    throw ConfigError("state buffer: anchor_share must be in [0, 1]");
 }
 
 StateBuffer::StateBuffer(int num_frames, const StateBufferOptions& options)
-    : options_(options), entries_(num_frames) {
+    : options_(options),
+      entries_(num_frames),
+      anchors_(num_frames),
+      has_anchor_(num_frames, false) {
   options_.Validate();
 }
 
@@ -73,6 +80,26 @@ int StateBuffer::Sample(int frame, std::mt19937_64& rng) const {
     if (draw <= 0.0) return static_cast<int>(i);
   }
   return static_cast<int>(slot.size()) - 1;
+}
+
+void StateBuffer::SetAnchor(int frame, const SimState& state) {
+  anchors_[frame] = state;
+  has_anchor_[frame] = true;
+}
+
+const SimState& StateBuffer::Draw(int frame, std::mt19937_64& rng) const {
+  const bool use_anchor =
+      has_anchor_[frame] &&
+      (entries_[frame].empty() || (options_.anchor_share > 0 &&
+                                   std::uniform_real_distribution<double>(
+                                       0.0, 1.0)(rng) < options_.anchor_share));
+  if (use_anchor) return anchors_[frame];
+  int index = Sample(frame, rng);
+  if (index < 0) {
+    throw std::logic_error("state buffer: frame " + std::to_string(frame) +
+                           " has no initial state");
+  }
+  return entries_[frame][index].state;
 }
 
 }  // namespace m2d

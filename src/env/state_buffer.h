@@ -4,6 +4,9 @@
 // with probability proportional to exp(score / temperature). Training
 // rescores states with the critic and inserts high-scoring visited states,
 // so infeasible initial states are gradually replaced by feasible ones.
+// A frame may also keep an anchor: the state it was first filled with (e.g.
+// the fit's estimate), never replaced, drawn with a fixed probability so
+// that training keeps practising the starts a user's rollout begins from.
 #ifndef MIMIC2D_ENV_STATE_BUFFER_H_
 #define MIMIC2D_ENV_STATE_BUFFER_H_
 
@@ -17,6 +20,7 @@ namespace m2d {
 struct StateBufferOptions {
   int capacity_per_frame = 4;  // states kept per reference frame
   double temperature = 1.0;    // of exp(score / T); in units of the score
+  double anchor_share = 0.0;   // probability a draw returns the frame's anchor
 
   void Validate() const;  // throws ConfigError
 };
@@ -52,9 +56,23 @@ class StateBuffer {
   // -1 when the frame is empty.
   int Sample(int frame, std::mt19937_64& rng) const;
 
+  // The frame's anchor state, kept apart from the scored entries; nullptr
+  // when the frame has none.
+  void SetAnchor(int frame, const SimState& state);
+  const SimState* anchor(int frame) const {
+    return has_anchor_[frame] ? &anchors_[frame] : nullptr;
+  }
+
+  // An episode's initial state for `frame`: its anchor with probability
+  // anchor_share (when it has one), otherwise a Sample()d entry. The frame
+  // must have an anchor or an entry.
+  const SimState& Draw(int frame, std::mt19937_64& rng) const;
+
  private:
   StateBufferOptions options_;
   std::vector<std::vector<ScoredState>> entries_;
+  std::vector<SimState> anchors_;
+  std::vector<bool> has_anchor_;
 };
 
 }  // namespace m2d

@@ -59,8 +59,7 @@ void TrackingEnv::Reset(float* observation) {
   const TrackedView& view = views[view_index];
   int frame = std::uniform_int_distribution<int>(0, view.num_frames - 2)(rng_);
   const StateBuffer& buffer = initial_states_->BufferOfView(view_index);
-  int entry = buffer.Sample(frame, rng_);
-  ResetTo(view_index, frame, buffer.entry(frame, entry).state, observation);
+  ResetTo(view_index, frame, buffer.Draw(frame, rng_), observation);
 }
 
 void TrackingEnv::ResetTo(int view_index, int frame, const SimState& state,

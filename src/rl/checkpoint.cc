@@ -20,8 +20,11 @@ namespace {
 // A checkpoint file is LibTorch's zip archive followed by a trailer: this
 // magic and a 64-bit FNV-1a hash of the archive bytes. The archive stores
 // tensors uncompressed and LibTorch 1.13 does not check its CRCs, so a
-// flipped bit would otherwise load as a silently different weight. Files
-// without the trailer (written before it existed) load unchecked.
+// flipped bit would otherwise load as a silently different weight. The
+// trailer is required: LibTorch's archive reader is not safe on damaged
+// files (fuzzing crashed its TorchScript type parser with a SEGV within a
+// few hundred mutations, docs/reliability.md), so no byte reaches it
+// unverified.
 constexpr char kTrailerMagic[8] = {'M', '2', 'D', 'C', 'K', 'S', 'U', 'M'};
 constexpr size_t kTrailerSize = sizeof(kTrailerMagic) + sizeof(uint64_t);
 
@@ -155,34 +158,55 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
 
 namespace {
 
+// LibTorch's archive reader reports a malformed file with c10::Error,
+// std::out_of_range, std::bad_alloc and others; every read of a checkpoint
+// goes through this, so the user always sees the file and the problem.
+template <typename Read>
+auto NamingCheckpointErrors(const std::string& path, const std::string& problem,
+                            Read read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const InputError&) {
+    throw;
+  } catch (const ConfigError& e) {
+    throw InputError(path, problem + " (" + e.what() + ")");
+  } catch (const c10::Error& e) {
+    throw InputError(path, problem + " (" + e.what_without_backtrace() + ")");
+  } catch (const std::exception& e) {
+    throw InputError(path, problem + " (" + e.what() + ")");
+  }
+}
+
 torch::serialize::InputArchive OpenArchive(const std::string& path) {
   const std::string contents = ReadFileText(path);
-  size_t archive_size = contents.size();
-  if (contents.size() >= kTrailerSize &&
+  if (contents.size() < kTrailerSize ||
       std::memcmp(contents.data() + contents.size() - kTrailerSize,
-                  kTrailerMagic, sizeof(kTrailerMagic)) == 0) {
-    archive_size = contents.size() - kTrailerSize;
-    uint64_t stored = 0;
-    std::memcpy(&stored, contents.data() + archive_size + sizeof(kTrailerMagic),
-                sizeof(stored));
-    if (Fnv1a64(contents.data(), archive_size) != stored) {
-      throw InputError(path,
-                       "checkpoint is corrupt (its checksum does not match "
-                       "its contents: a damaged or partly copied file)");
-    }
+                  kTrailerMagic, sizeof(kTrailerMagic)) != 0) {
+    throw InputError(path,
+                     "not a mimic2d checkpoint, or a damaged one: it does not "
+                     "end in mimic2d's checksum trailer (a partly copied "
+                     "file, or another program's)");
+  }
+  const size_t archive_size = contents.size() - kTrailerSize;
+  uint64_t stored = 0;
+  std::memcpy(&stored, contents.data() + archive_size + sizeof(kTrailerMagic),
+              sizeof(stored));
+  if (Fnv1a64(contents.data(), archive_size) != stored) {
+    throw InputError(path,
+                     "checkpoint is corrupt (its checksum does not match "
+                     "its contents: a damaged or partly copied file)");
   }
   torch::serialize::InputArchive archive;
-  try {
+  NamingCheckpointErrors(path, "not a readable checkpoint", [&] {
     archive.load_from(contents.data(), archive_size);
-  } catch (const c10::Error& e) {
-    throw InputError(path, "not a readable checkpoint (" +
-                               std::string(e.what_without_backtrace()) + ")");
-  }
+  });
   c10::IValue format;
-  if (!archive.try_read("format", format) || !format.isString() ||
-      format.toStringRef() != "mimic2d.checkpoint.v1") {
-    throw InputError(path, "not a mimic2d checkpoint");
-  }
+  const bool is_ours =
+      NamingCheckpointErrors(path, "not a mimic2d checkpoint", [&] {
+        return archive.try_read("format", format) && format.isString() &&
+               format.toStringRef() == "mimic2d.checkpoint.v1";
+      });
+  if (!is_ours) throw InputError(path, "not a mimic2d checkpoint");
   return archive;
 }
 
@@ -191,22 +215,42 @@ torch::serialize::InputArchive OpenArchive(const std::string& path) {
 TrainConfig ReadCheckpointConfig(const std::string& path) {
   torch::serialize::InputArchive archive = OpenArchive(path);
   c10::IValue text;
-  archive.read("config_yaml", text);
+  NamingCheckpointErrors(path, "no readable embedded config", [&] {
+    archive.read("config_yaml", text);
+    if (!text.isString()) throw InputError(path, "embedded config is not text");
+  });
   return LoadTrainConfigText(text.toStringRef(), path + " (embedded config)");
 }
 
 ObservationLayout ReadCheckpointLayout(const std::string& path,
                                        int* action_size) {
   torch::serialize::InputArchive archive = OpenArchive(path);
-  torch::Tensor values;
-  archive.read("layout", values);
-  ObservationLayout layout;
-  layout.num_bodies = static_cast<int>(values[0].item<int64_t>());
-  layout.num_objects = static_cast<int>(values[1].item<int64_t>());
-  layout.num_points = static_cast<int>(values[2].item<int64_t>());
-  layout.num_future_frames = static_cast<int>(values[3].item<int64_t>());
-  *action_size = static_cast<int>(values[4].item<int64_t>());
-  return layout;
+  return NamingCheckpointErrors(path, "malformed layout", [&] {
+    torch::Tensor values;
+    archive.read("layout", values);
+    values = values.to(torch::kInt64).flatten();
+    if (values.numel() != 5)
+      throw InputError(path, "layout must hold 5 counts");
+    // Bounds far above any character, so that a damaged count is named
+    // here rather than sizing networks beyond memory.
+    auto count = [&](int index, const char* name, int64_t low, int64_t high) {
+      const int64_t value = values[index].item<int64_t>();
+      if (value < low || value > high) {
+        throw InputError(path, std::string("layout ") + name + " " +
+                                   std::to_string(value) + " outside [" +
+                                   std::to_string(low) + ", " +
+                                   std::to_string(high) + "]");
+      }
+      return static_cast<int>(value);
+    };
+    ObservationLayout layout;
+    layout.num_bodies = count(0, "num_bodies", 1, 1000);
+    layout.num_objects = count(1, "num_objects", 0, 100);
+    layout.num_points = count(2, "num_points", 1, 1000);
+    layout.num_future_frames = count(3, "num_future_frames", 0, 1000);
+    *action_size = count(4, "action_size", 1, 1000);
+    return layout;
+  });
 }
 
 namespace {
@@ -334,6 +378,11 @@ void RestoreStateBuffers(const std::string& path,
     StateBuffer& buffer = initial_states->buffer(b);
     StateBuffer restored(buffer.num_frames(),
                          StateBufferOptions(buffer.options()));
+    // Anchors are this task's own fill, never saved: keep them.
+    for (int f = 0; f < buffer.num_frames(); ++f) {
+      if (const SimState* anchor = buffer.anchor(f))
+        restored.SetAnchor(f, *anchor);
+    }
     SimState state;
     for (int64_t row = 0; row < states.size(0); ++row) {
       int frame = static_cast<int>(frames[row].item<int64_t>());
@@ -383,9 +432,14 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
     }
     if (initial_states != nullptr)
       RestoreStateBuffers(path, archive, initial_states, state_template);
+  } catch (const InputError&) {
+    throw;
   } catch (const c10::Error& e) {
     throw InputError(path, "checkpoint does not match this config (" +
                                std::string(e.what_without_backtrace()) + ")");
+  } catch (const std::exception& e) {
+    throw InputError(path,
+                     std::string("malformed checkpoint (") + e.what() + ")");
   }
   return counters;
 }
@@ -394,31 +448,30 @@ void LoadCheckpointStateBuffers(const std::string& path,
                                 InitialStates* initial_states,
                                 const SimState& state_template) {
   torch::serialize::InputArchive archive = OpenArchive(path);
-  torch::Tensor saved_buffers;
-  if (!archive.try_read("asi_buffers", saved_buffers)) {
-    throw InputError(path, "holds no initial-state buffers");
-  }
-  // Only buffers known to belong to this reference: a checkpoint from
-  // before fingerprints cannot say which motion its buffers are of.
-  const std::optional<uint64_t> fingerprint =
-      SavedReferenceFingerprint(archive);
-  if (!fingerprint) {
-    throw InputError(path,
-                     "its initial-state buffers carry no reference "
-                     "fingerprint (an older checkpoint): cannot tell which "
-                     "motion they belong to");
-  }
-  if (*fingerprint != initial_states->reference_fingerprint()) {
-    throw InputError(path,
-                     "its initial-state buffers were filled for other "
-                     "reference motion than these bundles'");
-  }
-  try {
-    RestoreStateBuffers(path, archive, initial_states, state_template);
-  } catch (const c10::Error& e) {
-    throw InputError(path, "initial-state buffers do not fit this task (" +
-                               std::string(e.what_without_backtrace()) + ")");
-  }
+  NamingCheckpointErrors(
+      path, "initial-state buffers do not fit this task", [&] {
+        torch::Tensor saved_buffers;
+        if (!archive.try_read("asi_buffers", saved_buffers)) {
+          throw InputError(path, "holds no initial-state buffers");
+        }
+        // Only buffers known to belong to this reference: a checkpoint from
+        // before fingerprints cannot say which motion its buffers are of.
+        const std::optional<uint64_t> fingerprint =
+            SavedReferenceFingerprint(archive);
+        if (!fingerprint) {
+          throw InputError(
+              path,
+              "its initial-state buffers carry no reference "
+              "fingerprint (an older checkpoint): cannot tell which "
+              "motion they belong to");
+        }
+        if (*fingerprint != initial_states->reference_fingerprint()) {
+          throw InputError(path,
+                           "its initial-state buffers were filled for other "
+                           "reference motion than these bundles'");
+        }
+        RestoreStateBuffers(path, archive, initial_states, state_template);
+      });
 }
 
 }  // namespace m2d

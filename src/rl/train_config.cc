@@ -29,11 +29,17 @@ TrackingTaskOptions TrainingTaskOptions(const TrainConfig& config) {
 }
 
 void ModelOptions::Validate() const {
-  if (encoder_features < 1)
-    throw ConfigError("model.encoder_features must be >= 1");
+  // Upper bounds far above useful sizes: a typo (or a damaged checkpoint's
+  // config) is named instead of allocating beyond memory.
+  constexpr int kMaxWidth = 65536, kMaxLayers = 64;
+  if (encoder_features < 1 || encoder_features > kMaxWidth)
+    throw ConfigError("model.encoder_features must be in [1, 65536]");
   for (const auto* layers : {&encoder_hidden, &policy_hidden, &critic_hidden}) {
+    if (layers->size() > kMaxLayers)
+      throw ConfigError("model: at most 64 hidden layers per network");
     for (int width : *layers) {
-      if (width < 1) throw ConfigError("model: layer widths must be >= 1");
+      if (width < 1 || width > kMaxWidth)
+        throw ConfigError("model: layer widths must be in [1, 65536]");
     }
   }
   if (!(action_std > 0)) throw ConfigError("model.action_std must be > 0");
@@ -202,6 +208,7 @@ TrainConfig ParseTrainConfig(const YAML::Node& node,
   asi.Optional("capture_every_steps", &config.asi.capture_every_steps);
   asi.Optional("capacity_per_frame", &config.asi.buffer.capacity_per_frame);
   asi.Optional("temperature", &config.asi.buffer.temperature);
+  asi.Optional("anchor_share", &config.asi.buffer.anchor_share);
   asi.RejectUnknownKeys();
 
   YamlSection run = OpenSection(root, node, "run", yaml_path, &files, &source);
@@ -322,6 +329,8 @@ std::string TrainConfigToYaml(const TrainConfig& config) {
       << config.asi.buffer.capacity_per_frame;
   out << YAML::Key << "temperature" << YAML::Value
       << config.asi.buffer.temperature;
+  out << YAML::Key << "anchor_share" << YAML::Value
+      << config.asi.buffer.anchor_share;
   out << YAML::EndMap;
 
   out << YAML::Key << "run" << YAML::Value << YAML::BeginMap;

@@ -211,6 +211,20 @@ TEST(Checkpoint, TruncatedOrForeignFilesAreInputErrorsNamingTheFile) {
   });
   ExpectInputErrorNaming(truncated, [&] { ReadCheckpointConfig(truncated); });
 
+  // A whole LibTorch archive without our trailer (another program's, or
+  // one whose end was lost): LibTorch's reader never sees it.
+  const std::string untrailed = dir + "/untrailed.pt";
+  fs::copy_file(path, untrailed);
+  fs::resize_file(untrailed, fs::file_size(path) - 16);
+  std::string untrailed_message;
+  try {
+    ReadCheckpointConfig(untrailed);
+  } catch (const InputError& e) {
+    untrailed_message = e.what();
+  }
+  EXPECT_NE(untrailed_message.find("checksum trailer"), std::string::npos)
+      << untrailed_message;
+
   const std::string text = dir + "/notes.pt";
   std::ofstream(text) << "not a checkpoint\n";
   ExpectInputErrorNaming(text, [&] {
@@ -368,6 +382,9 @@ TEST(Checkpoint, InitialStateBuffersRoundTrip) {
   ASSERT_EQ(read.num_frames(), buffer.num_frames());
   for (int f = 0; f < buffer.num_frames(); ++f) {
     ASSERT_EQ(read.size(f), buffer.size(f)) << "frame " << f;
+    // Anchors are the task's own fill, kept through the restore.
+    ASSERT_NE(read.anchor(f), nullptr) << "frame " << f;
+    EXPECT_EQ(read.anchor(f)->qpos, buffer.anchor(f)->qpos) << "frame " << f;
     for (int i = 0; i < buffer.size(f); ++i) {
       SCOPED_TRACE("frame " + std::to_string(f) + " entry " +
                    std::to_string(i));
