@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test: builds if needed, runs the GoogleTest suites through ctest
 # (no test may skip: a fresh clone carries everything they need), then a
-# quick smoke pass of the benchmarks.
+# quick smoke pass of the benchmarks, then every command line of README.md.
 set -euo pipefail
 cd "$(dirname "$0")"
 [ -d build ] || ./setup.sh --no-demo
@@ -19,3 +19,6 @@ if [ -x build/m2d_bench ]; then
     || { cat build/bench_smoke.txt; exit 1; }
   tail -n 5 build/bench_smoke.txt
 fi
+# Every command line of the README, as a newcomer pastes them (docs/reliability.md).
+echo "== README commands"
+scripts/readme_commands.sh

@@ -15,6 +15,7 @@ namespace m2d::cli {
 namespace {
 
 struct FitArgs {
+  bool list_settings = false;
   std::string input;
   std::string output;
   std::string camera;  // "": the config's (default static)
@@ -31,6 +32,12 @@ struct FitArgs {
 constexpr double kMaxUnconvergedFraction = 0.25;
 
 int RunFit(FitArgs& args) {
+  if (args.list_settings) {
+    std::printf("%s", FitSettingsReference().c_str());
+    return 0;
+  }
+  if (args.input.empty() || args.output.empty())
+    throw InputError("", "fit: give an input bundle and -o OUTPUT");
   // The config file, then the command line's explicit settings over it.
   if (!args.config.empty()) args.options = ReadFitOptions(args.config);
   if (!args.camera.empty() &&
@@ -93,10 +100,11 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
       "fit",
       "Estimate each view's camera and the character's 3D poses from its 2D "
       "keypoints alone (Ceres), into the bundle's estimate section");
-  fit->add_option("input", args->input, "reference bundle (2D; truth unused)")
-      ->required();
-  fit->add_option("-o,--output", args->output, "bundle with the estimate")
-      ->required();
+  fit->add_option("input", args->input, "reference bundle (2D; truth unused)");
+  fit->add_option("-o,--output", args->output, "bundle with the estimate");
+  fit->add_flag("--list-settings", args->list_settings,
+                "Print every --config setting with its default, allowed "
+                "values and meaning (Markdown), and exit");
   fit->add_option("--camera", args->camera,
                   "static (tripod) or moving (smooth per-frame position); "
                   "default static");

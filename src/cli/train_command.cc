@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "common/blas_kernels.h"
+#include "common/error.h"
 #include "rl/trainer.h"
 
 namespace m2d::cli {
@@ -21,6 +22,7 @@ struct TrainArgs {
   int max_iterations = 0;
   std::string run_dir;
   int64_t total_samples = 0;
+  bool list_settings = false;
 };
 
 std::string FormatDuration(double seconds) {
@@ -33,6 +35,12 @@ std::string FormatDuration(double seconds) {
 }
 
 int RunTrain(const TrainArgs& args) {
+  if (args.list_settings) {
+    std::printf("%s", TrainSettingsReference().c_str());
+    return 0;
+  }
+  if (args.config_path.empty())
+    throw InputError("", "train: give a config (e.g. configs/walk.yaml)");
   TrainConfig config = LoadTrainConfig(args.config_path);
   if (!args.run_dir.empty()) config.run.run_dir = args.run_dir;
   if (args.total_samples > 0) config.run.total_samples = args.total_samples;
@@ -82,8 +90,10 @@ void AddTrainCommand(CLI::App& app, CommandRun* run) {
   train
       ->add_option("config", args->config_path,
                    "Training config (YAML), e.g. configs/walk.yaml")
-      ->required()
       ->check(CLI::ExistingFile);
+  train->add_flag("--list-settings", args->list_settings,
+                  "Print every config setting with its default, allowed "
+                  "values and meaning (Markdown), and exit");
   train->add_flag("--resume", args->resume,
                   "Continue from <run_dir>/checkpoint.pt");
   train->add_option("--iterations", args->max_iterations,

@@ -13,7 +13,12 @@ YamlSection::YamlSection(YAML::Node node, std::string source, std::string where)
   if (node_ && node_.IsMap()) {
     std::set<std::string> seen;
     for (const auto& entry : node_) {
-      const std::string key = entry.first.as<std::string>();
+      if (!entry.first.IsScalar()) {
+        throw InputError(source_, (where_.empty() ? "top level" : where_) +
+                                      ": a key is not a plain name (a list "
+                                      "or mapping used as a key)");
+      }
+      const std::string key = entry.first.Scalar();
       if (!seen.insert(key).second) Fail(key, "appears twice");
     }
   }
@@ -46,6 +51,18 @@ void YamlSection::Fail(const std::string& key,
                        const std::string& problem) const {
   throw InputError(source_, "'" + (where_.empty() ? key : where_ + "." + key) +
                                 "' " + problem);
+}
+
+std::string SettingsTableMarkdown(const std::vector<SettingRow>& rows) {
+  std::string table =
+      "| setting | default | allowed | meaning |\n|---|---|---|---|\n";
+  for (const SettingRow& row : rows) {
+    std::string default_value = row.default_value;
+    if (default_value.empty()) default_value = "\"\"";
+    table += "| `" + row.key + "` | `" + default_value + "` | " + row.range +
+             " | " + row.meaning + " |\n";
+  }
+  return table;
 }
 
 }  // namespace m2d

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/error.h"
+#include "common/settings.h"
 
 namespace m2d {
 
@@ -57,6 +58,146 @@ class YamlSection {
   std::string where_;
   std::set<std::string> read_keys_;
 };
+
+// Reads every field `Options::VisitFields` lists (common/settings.h) from
+// `section`: absent keys keep their values; a wrong type, an unknown enum
+// name or a value outside its range is an InputError naming the file and
+// the key. Unknown keys are left to the caller's RejectUnknownKeys() (one
+// section may hold the fields of several structs).
+class YamlFieldReader {
+ public:
+  explicit YamlFieldReader(YamlSection& section) : section_(section) {}
+
+  template <typename T>
+  void operator()(const char* key, T& value, const Range& range,
+                  const char* /*meaning*/) {
+    if constexpr (std::is_enum_v<T>) {
+      std::string name = SettingName(value);
+      section_.Optional(key, &name);
+      if (!ParseSetting(name, &value))
+        section_.Fail(key, "must be one of " + SettingChoices(value));
+    } else {
+      section_.Optional(key, &value);
+      if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+        CheckRange(key, static_cast<double>(value), range);
+      } else if constexpr (IsVector<T>::value) {
+        if constexpr (std::is_arithmetic_v<typename T::value_type>) {
+          for (const auto& element : value)
+            CheckRange(key, static_cast<double>(element), range);
+        }
+      }
+    }
+  }
+  template <typename Options>
+  void Nested(const char* key, Options& options) {
+    YamlSection inner = section_.Section(key);
+    YamlFieldReader reader(inner);
+    Options::VisitFields(options, reader);
+    inner.RejectUnknownKeys();
+  }
+
+ private:
+  void CheckRange(const char* key, double value, const Range& range) const {
+    if (!range.Contains(value))
+      section_.Fail(key, "must be in " + range.ToString());
+  }
+  YamlSection& section_;
+};
+
+template <typename Options>
+void ReadFields(YamlSection& section, Options& options) {
+  YamlFieldReader reader(section);
+  Options::VisitFields(options, reader);
+}
+
+// Emits every field as `key: value` pairs into the open map of `out`
+// (lists in flow style, enums by name, sub-sections as nested maps).
+class YamlFieldWriter {
+ public:
+  explicit YamlFieldWriter(YAML::Emitter& out) : out_(out) {}
+
+  template <typename T>
+  void operator()(const char* key, const T& value, const Range& /*range*/,
+                  const char* /*meaning*/) {
+    out_ << YAML::Key << key << YAML::Value;
+    WriteValue(out_, value);
+  }
+  template <typename Options>
+  void Nested(const char* key, const Options& options) {
+    out_ << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    Options::VisitFields(options, *this);
+    out_ << YAML::EndMap;
+  }
+
+  template <typename T>
+  static void WriteValue(YAML::Emitter& out, const T& value) {
+    if constexpr (std::is_enum_v<T>) {
+      out << SettingName(value);
+    } else if constexpr (IsVector<T>::value) {
+      out << YAML::Flow << value;
+    } else {
+      out << value;
+    }
+  }
+
+ private:
+  YAML::Emitter& out_;
+};
+
+template <typename Options>
+void WriteFields(YAML::Emitter& out, const Options& options) {
+  YamlFieldWriter writer(out);
+  Options::VisitFields(options, writer);
+}
+
+// One row of the settings reference: "section.key", the default as YAML,
+// the allowed range (or the enum's names) and the meaning.
+struct SettingRow {
+  std::string key;
+  std::string default_value;
+  std::string range;
+  std::string meaning;
+};
+
+class SettingRowCollector {
+ public:
+  SettingRowCollector(std::string section, std::vector<SettingRow>* rows)
+      : section_(std::move(section)), rows_(rows) {}
+
+  template <typename T>
+  void operator()(const char* key, const T& value, const Range& range,
+                  const char* meaning) {
+    YAML::Emitter text;
+    text.SetDoublePrecision(6);  // for reading; configs keep full precision
+    YamlFieldWriter::WriteValue(text, value);
+    std::string allowed;
+    if constexpr (std::is_enum_v<T>) {
+      allowed = SettingChoices(value);
+    } else {
+      allowed = range.ToString();
+    }
+    rows_->push_back({section_ + "." + key, text.c_str(), allowed, meaning});
+  }
+  template <typename Options>
+  void Nested(const char* key, const Options& options) {
+    SettingRowCollector inner(section_ + "." + key, rows_);
+    Options::VisitFields(options, inner);
+  }
+
+ private:
+  std::string section_;
+  std::vector<SettingRow>* rows_;
+};
+
+template <typename Options>
+void AppendSettingRows(const std::string& section, const Options& defaults,
+                       std::vector<SettingRow>* rows) {
+  SettingRowCollector collector(section, rows);
+  Options::VisitFields(defaults, collector);
+}
+
+// The rows as a Markdown table (setting | default | allowed | meaning).
+std::string SettingsTableMarkdown(const std::vector<SettingRow>& rows);
 
 }  // namespace m2d
 

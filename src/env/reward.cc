@@ -35,14 +35,7 @@ ReprojectionError MeasureReprojection(const double* projected_xy_px,
   return error;
 }
 
-void RewardWeights::Validate() const {
-  if (!(pose_weight >= 0 && energy_weight >= 0 && object_weight >= 0)) {
-    throw ConfigError("reward: weights must be >= 0");
-  }
-  if (!(pose_alpha_per_px > 0 && object_alpha_per_px > 0)) {
-    throw ConfigError("reward: alpha values must be > 0");
-  }
-}
+void RewardWeights::Validate() const { CheckRanges(*this, "env.reward"); }
 
 RewardTerms ComputeReward(const ReprojectionError& pose_error,
                           double abs_power_w,

@@ -3,6 +3,7 @@
 #ifndef MIMIC2D_ENV_REWARD_H_
 #define MIMIC2D_ENV_REWARD_H_
 
+#include "common/settings.h"
 #include "motion/clip2d.h"
 
 namespace m2d {
@@ -32,6 +33,21 @@ struct RewardWeights {
   double object_weight = 0.0;         // weight of the object 2D term
   double object_alpha_per_px = 0.02;  // alpha of the object term (1/px)
 
+  // Every setting (common/settings.h); a training config's `env.reward`.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("pose_weight", self.pose_weight, Range::AtLeast(0),
+      "w_p, weight of the 2D reprojection term exp(-alpha * error)");
+    v("pose_alpha_per_px", self.pose_alpha_per_px, Range::Above(0),
+      "alpha (1/px) on the confidence-weighted keypoint error sum");
+    v("energy_weight", self.energy_weight, Range::AtLeast(0),
+      "w_e, per watt of mechanical power sum_j abs(qdot_j tau_j) (a "
+      "penalty)");
+    v("object_weight", self.object_weight, Range::AtLeast(0),
+      "weight of the object's 2D term (0: no object)");
+    v("object_alpha_per_px", self.object_alpha_per_px, Range::Above(0),
+      "alpha (1/px) of the object term");
+  }
   void Validate() const;  // throws ConfigError
 };
 

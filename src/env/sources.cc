@@ -36,20 +36,38 @@ const char* SourceName(CameraSource source) {
 }
 
 InitialStateSource ParseInitialStateSource(const std::string& text) {
-  for (InitialStateSource source :
-       {InitialStateSource::kTruth, InitialStateSource::kEstimate,
-        InitialStateSource::kDefault}) {
-    if (text == SourceName(source)) return source;
-  }
+  InitialStateSource source;
+  if (ParseSetting(text, &source)) return source;
   throw ConfigError("unknown initial-state source '" + text +
                     "': truth, estimate or default");
 }
 
 CameraSource ParseCameraSource(const std::string& text) {
-  for (CameraSource source : {CameraSource::kTruth, CameraSource::kEstimate}) {
-    if (text == SourceName(source)) return source;
-  }
+  CameraSource source;
+  if (ParseSetting(text, &source)) return source;
   throw ConfigError("unknown camera source '" + text + "': truth or estimate");
+}
+
+bool ParseSetting(const std::string& text, InitialStateSource* source) {
+  for (InitialStateSource known :
+       {InitialStateSource::kTruth, InitialStateSource::kEstimate,
+        InitialStateSource::kDefault}) {
+    if (text == SourceName(known)) {
+      *source = known;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool ParseSetting(const std::string& text, CameraSource* source) {
+  for (CameraSource known : {CameraSource::kTruth, CameraSource::kEstimate}) {
+    if (text == SourceName(known)) {
+      *source = known;
+      return true;
+    }
+  }
+  return false;
 }
 
 std::string DescribeSources(const TaskSources& sources) {

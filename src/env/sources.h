@@ -35,6 +35,21 @@ const char* SourceName(CameraSource source);
 InitialStateSource ParseInitialStateSource(const std::string& text);
 CameraSource ParseCameraSource(const std::string& text);
 
+// The same as settings (common/settings.h: found by argument-dependent
+// lookup when a config field is one of these enums).
+inline const char* SettingName(InitialStateSource source) {
+  return SourceName(source);
+}
+inline const char* SettingName(CameraSource source) {
+  return SourceName(source);
+}
+bool ParseSetting(const std::string& text, InitialStateSource* source);
+bool ParseSetting(const std::string& text, CameraSource* source);
+inline std::string SettingChoices(InitialStateSource) {
+  return "truth, estimate, default";
+}
+inline std::string SettingChoices(CameraSource) { return "truth, estimate"; }
+
 // "starts from <...>, cameras <...>" for logs and tables.
 std::string DescribeSources(const TaskSources& sources);
 

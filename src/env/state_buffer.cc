@@ -9,15 +9,7 @@
 
 namespace m2d {
 
-void StateBufferOptions::Validate() const {
-  if (capacity_per_frame < 1) {
-    throw ConfigError("state buffer: capacity_per_frame must be >= 1");
-  }
-  if (!(temperature > 0))
-    throw ConfigError("state buffer: temperature must be > 0");
-  if (!(anchor_share >= 0 && anchor_share <= 1))
-    throw ConfigError("state buffer: anchor_share must be in [0, 1]");
-}
+void StateBufferOptions::Validate() const { CheckRanges(*this, "asi"); }
 
 StateBuffer::StateBuffer(int num_frames, const StateBufferOptions& options)
     : options_(options),

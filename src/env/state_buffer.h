@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "common/settings.h"
 #include "sim/simulation.h"
 
 namespace m2d {
@@ -22,6 +23,18 @@ struct StateBufferOptions {
   double temperature = 1.0;    // of exp(score / T); in units of the score
   double anchor_share = 0.0;   // probability a draw returns the frame's anchor
 
+  // Every setting (common/settings.h); spliced into a training config's
+  // `asi` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("capacity_per_frame", self.capacity_per_frame, Range::Closed(1, 1024),
+      "states kept per reference frame");
+    v("temperature", self.temperature, Range::Above(0),
+      "T of sampling proportional to exp(V / T), V in return units");
+    v("anchor_share", self.anchor_share, Range::Closed(0, 1),
+      "share of episodes started from the frame's first-filled state "
+      "(never replaced by ASI)");
+  }
   void Validate() const;  // throws ConfigError
 };
 

@@ -6,19 +6,7 @@
 
 namespace m2d {
 
-void TrackingEnvOptions::Validate() const {
-  simulation.Validate();
-  reward.Validate();
-  if (num_future_frames < 1)
-    throw ConfigError("env: num_future_frames must be >= 1");
-  if (!(max_episode_s > 0)) throw ConfigError("env: max_episode_s must be > 0");
-  if (!(early_exit_max_error_px > 0)) {
-    throw ConfigError("env: early_exit_max_error_px must be > 0");
-  }
-  if (!(initial_state_noise_rad >= 0)) {
-    throw ConfigError("env: initial_state_noise_rad must be >= 0");
-  }
-}
+void TrackingEnvOptions::Validate() const { CheckRanges(*this, "env"); }
 
 TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
                          std::shared_ptr<const TrackingReference> reference,

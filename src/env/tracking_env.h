@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/settings.h"
 #include "env/observation.h"
 #include "env/reference.h"
 #include "env/reward.h"
@@ -29,6 +30,27 @@ struct TrackingEnvOptions {
   // visited states. Read by whoever fills the buffers (the Trainer passes it
   // to InitialStates), not by the environment; 0 disables.
   double initial_state_noise_rad = 0.0;
+
+  // Every setting (common/settings.h); a training config's `env` section
+  // (the simulation's fields spliced in, the reward as `env.reward`).
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    decltype(self.simulation)::VisitFields(self.simulation, v);
+    v("num_future_frames", self.num_future_frames, Range::Closed(1, 1000),
+      "L: future reference frames in the observation");
+    v("max_episode_s", self.max_episode_s, Range::Above(0),
+      "episodes are truncated after this (s)");
+    v("early_exit", self.early_exit, Range::Any(),
+      "end an episode when its worst keypoint is off by more than "
+      "early_exit_max_error_px (the paper's reprojection early exit)");
+    v("early_exit_max_error_px", self.early_exit_max_error_px, Range::Above(0),
+      "the early exit's threshold (px)");
+    v("initial_state_noise_rad", self.initial_state_noise_rad,
+      Range::AtLeast(0),
+      "Noisy S.I.: sigma (rad) added once to the joint angles of the "
+      "initial-state buffers when they are filled");
+    v.Nested("reward", self.reward);
+  }
 
   int max_episode_steps() const {
     return static_cast<int>(max_episode_s * simulation.control_hz + 0.5);

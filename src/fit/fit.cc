@@ -672,44 +672,7 @@ const char* CameraMotionName(CameraMotion motion) {
   return motion == CameraMotion::kMoving ? "moving" : "static";
 }
 
-void FitOptions::Validate() const {
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw ConfigError(std::string("fit: ") + what);
-  };
-  require(fixed_focal_px >= 0 && std::isfinite(fixed_focal_px),
-          "focal length must be > 0 px (or 0 to estimate it)");
-  require(min_confidence >= 0 && min_confidence <= 1,
-          "min_confidence must be in [0, 1]");
-  require(reprojection_sigma > 0 && std::isfinite(reprojection_sigma),
-          "reprojection_sigma must be > 0");
-  for (double weight :
-       {pose_prior_weight, pose_smooth_weight, root_smooth_weight,
-        turn_smooth_weight, ground_weight, penetration_weight,
-        foot_slide_weight, camera_smooth_weight, camera_speed_weight,
-        upright_weight, camera_height_prior_weight,
-        moving_camera_height_prior_weight, focal_prior_weight}) {
-    require(weight >= 0 && std::isfinite(weight),
-            "term weights must be finite and >= 0");
-  }
-  require(contact_height_m > 0 && std::isfinite(contact_height_m),
-          "contact_height_m must be > 0");
-  require(num_facing_starts >= 1 && num_facing_starts <= 16,
-          "num_facing_starts must be in [1, 16]");
-  require(screening_iterations >= 1 && root_stage_iterations >= 1 &&
-              pose_stage_iterations >= 1,
-          "stage iterations must be >= 1");
-  require(num_threads >= 1, "num_threads must be >= 1");
-  require(contact_speed_mps > 0 && std::isfinite(contact_speed_mps),
-          "contact_speed_mps must be > 0");
-  require(contact_rounds >= 1, "contact_rounds must be >= 1");
-  require(unconverged_residual_scale > 0,
-          "unconverged_residual_scale must be > 0");
-  require(min_frames >= 3, "min_frames must be >= 3");
-  require(min_keypoints_per_frame >= 4, "min_keypoints_per_frame must be >= 4");
-  require(min_person_scale_px > 0, "min_person_scale_px must be > 0");
-  require(min_usable_fraction > 0 && min_usable_fraction <= 1,
-          "min_usable_fraction must be in (0, 1]");
-}
+void FitOptions::Validate() const { CheckRanges(*this, "fit"); }
 
 ViewEstimate FitView(const Clip2D& clip, const Character& character,
                      const FitOptions& options, const std::string& source) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "common/settings.h"
 #include "motion/bundle.h"
 #include "motion/clip2d.h"
 
@@ -24,6 +25,14 @@ enum class CameraMotion {
 // "static" / "moving"; false when unknown.
 bool ParseCameraMotion(const std::string& text, CameraMotion* motion);
 const char* CameraMotionName(CameraMotion motion);
+// As a setting (common/settings.h).
+inline const char* SettingName(CameraMotion motion) {
+  return CameraMotionName(motion);
+}
+inline bool ParseSetting(const std::string& text, CameraMotion* motion) {
+  return ParseCameraMotion(text, motion);
+}
+inline std::string SettingChoices(CameraMotion) { return "static, moving"; }
 
 struct FitOptions {
   CameraMotion camera_motion = CameraMotion::kStatic;
@@ -95,6 +104,79 @@ struct FitOptions {
   // Called with a progress line after each stage (empty: silent).
   std::function<void(const std::string& line)> progress;
 
+  // Every setting of `mimic2d fit --config` (common/settings.h); the
+  // reasons for the defaults are in the comments above.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    const Range weight = Range::AtLeast(0);
+    v("camera_motion", self.camera_motion, Range::Any(),
+      "a tripod (one camera) or a smooth per-frame centre");
+    v("fixed_focal_px", self.fixed_focal_px, Range::AtLeast(0),
+      "> 0: the known focal length (px), held fixed; 0: estimated");
+    v("min_confidence", self.min_confidence, Range::Closed(0, 1),
+      "keypoints below this confidence are ignored");
+    v("reprojection_sigma", self.reprojection_sigma, Range::Above(0),
+      "Geman-McClure sigma of the 2D term, in person sizes");
+    v("pose_prior_weight", self.pose_prior_weight, weight,
+      "per hinge angle (rad) from rest");
+    v("pose_smooth_weight", self.pose_smooth_weight, weight,
+      "hinge acceleration (rad per frame^2)");
+    v("root_smooth_weight", self.root_smooth_weight, weight,
+      "root acceleration (m per frame^2)");
+    v("turn_smooth_weight", self.turn_smooth_weight, weight,
+      "root angular acceleration (rad per frame^2)");
+    v("ground_weight", self.ground_weight, weight,
+      "lowest sole point's height (m)");
+    v("penetration_weight", self.penetration_weight, weight,
+      "each sole point below the floor (m)");
+    v("foot_slide_weight", self.foot_slide_weight, weight,
+      "in-contact sole point's step (m)");
+    v("camera_smooth_weight", self.camera_smooth_weight, weight,
+      "moving camera centre's acceleration (m per frame^2)");
+    v("camera_speed_weight", self.camera_speed_weight, weight,
+      "moving camera centre's speed (m per frame)");
+    v("focal_prior_weight", self.focal_prior_weight, weight,
+      "log(focal / prior at the image diagonal)");
+    v("upright_weight", self.upright_weight, weight,
+      "horizontal part of the root's up axis");
+    v("camera_height_prior_m", self.camera_height_prior_m, Range::Above(0),
+      "camera height prior (m), eye level");
+    v("camera_height_prior_weight", self.camera_height_prior_weight, weight,
+      "log(height / prior), static camera");
+    v("moving_camera_height_prior_weight",
+      self.moving_camera_height_prior_weight, weight,
+      "log(height / prior), moving camera");
+    v("contact_height_m", self.contact_height_m, Range::Above(0),
+      "soles within this height are in contact (m)");
+    v("contact_speed_mps", self.contact_speed_mps, Range::Above(0),
+      "soles faster than this are not in contact (m/s)");
+    v("contact_rounds", self.contact_rounds, Range::Closed(1, 100),
+      "full-pose solves, contacts relabelled before each");
+    v("num_facing_starts", self.num_facing_starts, Range::Closed(1, 16),
+      "headings tried for the facing ambiguity");
+    v("root_stage_iterations", self.root_stage_iterations,
+      Range::Closed(1, 100000), "stage 1 iterations per facing start");
+    v("screening_iterations", self.screening_iterations,
+      Range::Closed(1, 100000), "stage 2 screening iterations per start");
+    v("pose_stage_iterations", self.pose_stage_iterations,
+      Range::Closed(1, 100000), "full-pose iterations per round");
+    v("num_threads", self.num_threads, Range::Closed(1, 1024), "Ceres threads");
+    v("function_tolerance", self.function_tolerance, Range::Above(0),
+      "relative cost change that stops a solve");
+    v("unconverged_residual_scale", self.unconverged_residual_scale,
+      Range::Above(0),
+      "a frame with mean error above this many person sizes did not "
+      "converge");
+    v("min_frames", self.min_frames, Range::AtLeast(3),
+      "a clip needs this many frames");
+    v("min_keypoints_per_frame", self.min_keypoints_per_frame,
+      Range::Closed(4, 17), "confident keypoints a usable frame needs");
+    v("min_person_scale_px", self.min_person_scale_px, Range::Above(0),
+      "smallest person (px, RMS spread about the root)");
+    v("min_usable_fraction", self.min_usable_fraction,
+      Range{0, 1, /*min_open=*/true, /*max_open=*/false},
+      "share of usable frames a clip needs");
+  }
   void Validate() const;  // throws ConfigError
 };
 

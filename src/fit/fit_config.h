@@ -15,6 +15,10 @@ namespace m2d {
 FitOptions ReadFitOptions(const std::string& path,
                           const FitOptions& defaults = {});
 
+// Every FitOptions setting with its default, allowed values and meaning, as
+// a Markdown table (docs/fit.md; `mimic2d fit --list-settings`).
+std::string FitSettingsReference();
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_FIT_FIT_CONFIG_H_

@@ -25,6 +25,21 @@ struct DataOptions {
   InitialStateSource initial_states = InitialStateSource::kTruth;
   CameraSource cameras = CameraSource::kTruth;
 
+  // Every setting (common/settings.h): the config's `data` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("character_config", self.character_config, Range::Any(),
+      "the character: MJCF, keypoint map and actuation (YAML)");
+    v("scene", self.scene, Range::Any(),
+      "the scene it is loaded into (flat, ball, ...)");
+    v("bundles", self.bundles, Range::Any(),
+      "reference bundle files (one or more)");
+    v("initial_states", self.initial_states, Range::Any(),
+      "where episodes start: the 3D truth, the `mimic2d fit` estimate (2D "
+      "only) or a default pose");
+    v("cameras", self.cameras, Range::Any(),
+      "which cameras project: the true ones or the fit's estimate");
+  }
   TaskSources sources() const { return {initial_states, cameras}; }
   void Validate() const;
 };
@@ -38,6 +53,23 @@ struct ModelOptions {
   double action_std = 0.1;        // Gaussian sigma, in normalized actions
   bool learn_action_std = false;  // fixed sigma, as MimicKit and PHC
 
+  // Every setting (common/settings.h): the config's `model` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    const Range width = Range::Closed(1, 65536);
+    v("encoder_hidden", self.encoder_hidden, width,
+      "hidden layer widths of phi, the per-view 2D encoder");
+    v("encoder_features", self.encoder_features, width,
+      "phi's output size (averaged over views for 3D tracking)");
+    v("policy_hidden", self.policy_hidden, width,
+      "hidden layer widths of the policy MLP");
+    v("critic_hidden", self.critic_hidden, width,
+      "hidden layer widths of the critic MLP");
+    v("action_std", self.action_std, Range::Above(0),
+      "Gaussian sigma, in normalized action units");
+    v("learn_action_std", self.learn_action_std, Range::Any(),
+      "learn sigma instead of keeping it fixed");
+  }
   void Validate() const;
 };
 
@@ -70,6 +102,46 @@ struct PpoOptions {
   // for the cores.
   bool adapt_torch_threads = false;
 
+  // Every setting (common/settings.h): the config's `agent` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("num_envs", self.num_envs, Range::Closed(1, 65536),
+      "parallel environments");
+    v("steps_per_env", self.steps_per_env, Range::Closed(1, 65536),
+      "rollout horizon per iteration (batch = num_envs x steps_per_env)");
+    v("discount", self.discount, Range::Open(0, 1), "gamma");
+    v("gae_lambda", self.gae_lambda, Range::Closed(0, 1), "lambda of GAE");
+    v("clip_ratio", self.clip_ratio, Range::Above(0), "PPO surrogate clip");
+    v("advantage_clip", self.advantage_clip, Range::Above(0),
+      "clip of normalized advantages");
+    v("epochs", self.epochs, Range::Closed(1, 1000), "passes over each batch");
+    v("minibatch_size", self.minibatch_size, Range::AtLeast(1),
+      "samples per gradient step (at most the batch)");
+    v("learning_rate", self.learning_rate, Range::Above(0),
+      "Adam's rate; with target_kl > 0 the first iteration's");
+    v("target_kl", self.target_kl, Range::AtLeast(0),
+      "> 0: adapt the rate toward this KL per update (rl_games rule); 0: "
+      "fixed rate");
+    v("learning_rate_min", self.learning_rate_min, Range::Above(0),
+      "lower bound of the adaptive rate");
+    v("learning_rate_max", self.learning_rate_max, Range::Above(0),
+      "upper bound of the adaptive rate");
+    v("max_grad_norm", self.max_grad_norm, Range::Above(0),
+      "global gradient-norm clip");
+    v("value_loss_weight", self.value_loss_weight, Range::AtLeast(0),
+      "weight of the critic's loss");
+    v("entropy_weight", self.entropy_weight, Range::AtLeast(0),
+      "entropy bonus (only matters with a learned sigma)");
+    v("action_bound_weight", self.action_bound_weight, Range::AtLeast(0),
+      "penalty on Gaussian means beyond [-1, 1]");
+    v("normalize_observations", self.normalize_observations, Range::Any(),
+      "running mean/std of observations, saved in checkpoints");
+    v("torch_threads", self.torch_threads, Range::Closed(1, 1024),
+      "LibTorch intra-op threads");
+    v("adapt_torch_threads", self.adapt_torch_threads, Range::Any(),
+      "probe 1 thread against torch_threads while training and keep the "
+      "faster");
+  }
   int batch_size() const { return num_envs * steps_per_env; }
   void Validate() const;
 };
@@ -80,6 +152,15 @@ struct AsiOptions {
   int capture_every_steps = 4;        // visited states offered to the buffers
   StateBufferOptions buffer{4, 2.0};  // per frame: 4 states, T = 2 (of V)
 
+  // Every setting (common/settings.h): the config's `asi` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("enabled", self.enabled, Range::Any(),
+      "Adaptive State Initialization on/off");
+    v("capture_every_steps", self.capture_every_steps, Range::AtLeast(1),
+      "visited states are offered to the buffers every this many steps");
+    decltype(self.buffer)::VisitFields(self.buffer, v);
+  }
   void Validate() const;
 };
 
@@ -91,6 +172,19 @@ struct RunOptions {
   double checkpoint_minutes = 5.0;     // periodic atomic checkpoint
   int env_threads = 2;                 // OpenMP threads stepping envs
 
+  // Every setting (common/settings.h): the config's `run` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("run_dir", self.run_dir, Range::Any(),
+      "checkpoint.pt, train_log.csv and config.yaml go here");
+    v("seed", self.seed, Range::Any(), "seed of every random stream");
+    v("total_samples", self.total_samples, Range::AtLeast(1),
+      "stop after this many environment steps");
+    v("checkpoint_minutes", self.checkpoint_minutes, Range::Above(0),
+      "period of the atomic checkpoint (minutes)");
+    v("env_threads", self.env_threads, Range::Closed(1, 1024),
+      "OpenMP threads stepping environments");
+  }
   void Validate() const;
 };
 
@@ -122,6 +216,11 @@ TrainConfig LoadTrainConfig(const std::string& yaml_path);
 std::string TrainConfigToYaml(const TrainConfig& config);
 TrainConfig LoadTrainConfigText(const std::string& yaml_text,
                                 const std::string& source);
+
+// Every setting of a training config with its default, allowed values and
+// meaning, as a Markdown table (configs/README.md; `mimic2d train
+// --list-settings`).
+std::string TrainSettingsReference();
 
 }  // namespace m2d
 

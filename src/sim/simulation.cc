@@ -41,18 +41,7 @@ inline double TargetFor(const ActuatedHinge& hinge, float normalized_action) {
 
 }  // namespace
 
-void SimulationOptions::Validate() const {
-  if (!(std::isfinite(control_hz) && control_hz > 0.0)) {
-    throw ConfigError("control_hz must be positive");
-  }
-  if (physics_substeps < 1) {
-    throw ConfigError("physics_substeps must be at least 1");
-  }
-  if (!(max_joint_speed_rad_s > 0.0) || !(max_linear_speed_m_s > 0.0) ||
-      !(max_object_spin_rad_s > 0.0)) {
-    throw ConfigError("divergence speed limits must be positive");
-  }
-}
+void SimulationOptions::Validate() const { CheckRanges(*this, "env"); }
 
 std::shared_ptr<const Character> LoadCharacterForSimulation(
     const std::string& config_path, const std::string& scene_name,

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/settings.h"
 #include "motion/motion3d.h"
 #include "sim/character.h"
 #include "sim/mujoco_handles.h"
@@ -27,10 +28,28 @@ struct SimulationOptions {
   double max_linear_speed_m_s = 50.0;     // every free body's translation
   double max_object_spin_rad_s = 1000.0;  // non-character free bodies
 
+  // Every setting (common/settings.h); a training config's `env` section.
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("control_hz", self.control_hz, Range::Closed(1, 1000),
+      "policy rate (Hz): one step per control period; bundles must be at "
+      "this fps");
+    v("physics_substeps", self.physics_substeps, Range::Closed(1, 100),
+      "physics steps per control period (2 is the humanoid's stability "
+      "limit, 4 halves ground penetration)");
+    v("max_joint_speed_rad_s", self.max_joint_speed_rad_s, Range::Above(0),
+      "divergence limit: any rotational DoF faster than this ends the "
+      "episode as diverged");
+    v("max_linear_speed_m_s", self.max_linear_speed_m_s, Range::Above(0),
+      "divergence limit on every free body's translation");
+    v("max_object_spin_rad_s", self.max_object_spin_rad_s, Range::Above(0),
+      "divergence limit on non-character free bodies' spin");
+  }
+
   double physics_timestep_s() const {
     return 1.0 / (control_hz * physics_substeps);
   }
-  // Throws ConfigError on a non-positive rate or limit.
+  // Throws ConfigError when a field is outside its range.
   void Validate() const;
 };
 

@@ -315,8 +315,17 @@ TEST(Cli, UnknownOrMissingCommandsListTheCommands) {
   // A command's own help, not the main one.
   result = RunMimic2d("fit --help");
   EXPECT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_NE(result.output.find("mimic2d fit [OPTIONS] input"),
+  EXPECT_NE(result.output.find("mimic2d fit [OPTIONS] [input]"),
             std::string::npos)
+      << result.output;
+  // The input is optional only for --list-settings.
+  result = RunMimic2d("fit");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("give an input bundle"), std::string::npos)
+      << result.output;
+  result = RunMimic2d("train --list-settings");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("`asi.anchor_share`"), std::string::npos)
       << result.output;
 }
 

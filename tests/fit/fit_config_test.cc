@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "common/error.h"
+#include "common/file_io.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -52,7 +53,8 @@ TEST(FitConfig, KeysSetTheirFieldsAndTheRestKeepDefaults) {
 
 TEST(FitConfig, BadFilesAreNamedErrors) {
   const std::string dir = testing::TempDir("fit_config_bad");
-  const std::string typo = WriteYaml(dir, "typo.yaml", "pose_smoth_weight: 1\n");
+  const std::string typo =
+      WriteYaml(dir, "typo.yaml", "pose_smoth_weight: 1\n");
   std::string message = InputErrorOf([&] { ReadFitOptions(typo); });
   EXPECT_NE(message.find(typo), std::string::npos) << message;
   EXPECT_NE(message.find("'pose_smoth_weight' is not a known setting"),
@@ -69,13 +71,15 @@ TEST(FitConfig, BadFilesAreNamedErrors) {
       WriteYaml(dir, "invalid.yaml", "ground_weight: -1\n");
   message = InputErrorOf([&] { ReadFitOptions(invalid); });
   EXPECT_NE(message.find(invalid), std::string::npos) << message;
-  EXPECT_NE(message.find("term weights must be finite"), std::string::npos)
+  EXPECT_NE(message.find("'ground_weight' must be in [0, inf)"),
+            std::string::npos)
       << message;
 
   const std::string motion =
       WriteYaml(dir, "motion.yaml", "camera_motion: panning\n");
   message = InputErrorOf([&] { ReadFitOptions(motion); });
-  EXPECT_NE(message.find("must be static or moving"), std::string::npos)
+  EXPECT_NE(message.find("'camera_motion' must be one of static, moving"),
+            std::string::npos)
       << message;
 
   const std::string list = WriteYaml(dir, "list.yaml", "- 1\n- 2\n");
@@ -84,6 +88,22 @@ TEST(FitConfig, BadFilesAreNamedErrors) {
 
   message = InputErrorOf([&] { ReadFitOptions(dir + "/absent.yaml"); });
   EXPECT_NE(message.find("cannot open"), std::string::npos) << message;
+}
+
+// The settings table in docs/fit.md is FitOptions::VisitFields' own.
+TEST(FitConfig, DocsListEverySettingAsDeclared) {
+  const std::string table = FitSettingsReference();
+  EXPECT_NE(table.find("| `ground_weight` | `10` | [0, inf) |"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("| `camera_motion` | `static` | static, moving |"),
+            std::string::npos)
+      << table;
+  const std::string docs =
+      ReadFileText(std::string(MIMIC2D_SOURCE_DIR) + "/docs/fit.md");
+  EXPECT_NE(docs.find(table), std::string::npos)
+      << "docs/fit.md's settings table is stale: replace it with the output "
+         "of `build/mimic2d fit --list-settings`";
 }
 
 }  // namespace

@@ -1,10 +1,12 @@
 #include "rl/train_config.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 
 #include "common/error.h"
+#include "common/file_io.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -88,11 +90,53 @@ TEST(TrainConfig, SourcesDefaultToTheTruthAndRoundTrip) {
             CameraSource::kTruth);
 }
 
+// One list of fields (VisitFields) makes the parser, the emitter, the range
+// checks and the reference table: every key the table lists round-trips.
+TEST(TrainConfig, TheSettingsReferenceListsEveryEmittedKey) {
+  const std::string table = TrainSettingsReference();
+  const std::string yaml = TrainConfigToYaml(TrainConfig());
+  const YAML::Node root = YAML::Load(yaml);
+  int keys = 0;
+  for (const auto& section : root) {
+    for (const auto& field : section.second) {
+      const std::string key =
+          section.first.Scalar() + "." + field.first.Scalar();
+      if (field.second.IsMap()) {
+        for (const auto& inner : field.second) {
+          EXPECT_NE(table.find("`" + key + "." + inner.first.Scalar() + "`"),
+                    std::string::npos)
+              << key;
+          ++keys;
+        }
+      } else {
+        EXPECT_NE(table.find("`" + key + "`"), std::string::npos) << key;
+        ++keys;
+      }
+    }
+  }
+  EXPECT_GT(keys, 40);
+  // Ranges and defaults come from the same list.
+  EXPECT_NE(table.find("| `agent.discount` | `0.99` | (0, 1) |"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("| `asi.anchor_share` | `0` | [0, 1] |"),
+            std::string::npos)
+      << table;
+  // configs/README.md carries the same table (regenerate with `mimic2d
+  // train --list-settings`).
+  const std::string readme =
+      ReadFileText(std::string(MIMIC2D_SOURCE_DIR) + "/configs/README.md");
+  EXPECT_NE(readme.find(table), std::string::npos)
+      << "configs/README.md's settings table is stale: replace it with the "
+         "output of `build/mimic2d train --list-settings`";
+}
+
 TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
   ExpectConfigError("data: {bundles: [a.json], initial_states: fitted}\n",
-                    "'data.initial_states' is not known");
+                    "'data.initial_states' must be one of truth, estimate, "
+                    "default");
   ExpectConfigError("data: {bundles: [a.json], cameras: default}\n",
-                    "'data.cameras' is not known");
+                    "'data.cameras' must be one of truth, estimate");
   ExpectConfigError(
       "data: {bundles: [a.json], initial_states: estimate, cameras: truth}\n",
       "initial_states: estimate needs cameras: estimate");
@@ -129,6 +173,13 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
   ExpectConfigError(
       "data: {bundles: [a.json]}\nagent: {epochs: 3, epochs: 5}\n",
       "'agent.epochs' appears twice");
+  // libFuzzer (scripts/fuzz.sh): a list used as a key escaped as
+  // YAML::TypedBadConversion and aborted.
+  ExpectConfigError("data: {bundles: [a.json]}\nagent: {[epochs]: 3}\n",
+                    "a key is not a plain name");
+  ExpectConfigError(
+      "data: {bundles: [a.json]}\nmodel: {policy_hidden: [100000]}\n",
+      "'model.policy_hidden' must be in [1, 65536]");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: /dev/null\n",
                     "not a regular file", false);
   ExpectConfigError("data: {bundles: [a.json]}\nagent: /tmp\n",
