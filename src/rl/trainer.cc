@@ -10,13 +10,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "common/error.h"
 #include "common/file_io.h"
 #include "env/vec_env.h"
 #include "motion/bundle.h"
+#include "rl/asi_updater.h"
 #include "rl/checkpoint.h"
 #include "rl/ppo.h"
 #include "rl/thread_tuner.h"
@@ -30,77 +29,11 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-constexpr char kLogHeader[] =
-    "iteration,samples,wall_time_s,samples_per_s,mean_return,mean_episode_"
-    "length,succ,e2d_px,"
-    "policy_loss,value_loss,entropy,learning_rate,approx_kl,clip_fraction,"
-    "torch_threads";
-
-std::vector<std::string> SplitFields(const std::string& row) {
-  std::vector<std::string> fields;
-  std::istringstream in(row);
-  std::string field;
-  while (std::getline(in, field, ',')) fields.push_back(field);
-  if (!row.empty() && row.back() == ',') fields.emplace_back();
-  return fields;
-}
-
-// What a resumed run may need from the log's last row.
-struct LastLogRow {
-  double wall_time_s = -1.0;
-  double learning_rate = -1.0;
-};
-
-// Keeps the log rows up to `iteration` (a resumed run rewrites what came
-// after its checkpoint) and returns the last kept row. Rows of a log written
-// before columns were added get empty cells for them (missing values).
-LastLogRow TrimLog(const std::string& path, int iteration) {
-  std::ifstream in(path);
-  std::ostringstream kept;
-  kept << kLogHeader << "\n";
-  const std::vector<std::string> columns = SplitFields(kLogHeader);
-  auto column = [&](const char* name) {
-    return static_cast<size_t>(std::find(columns.begin(), columns.end(), name) -
-                               columns.begin());
-  };
-  const size_t wall_time_column = column("wall_time_s");
-  const size_t learning_rate_column = column("learning_rate");
-  std::string line;
-  LastLogRow last;
-  std::getline(in, line);  // header
-  while (std::getline(in, line)) {
-    // Rows past the checkpoint, or torn by a kill mid-write, are dropped. A
-    // torn row's iteration is past the checkpoint too, unless the tear cut
-    // the number itself short ("1" of "12,..."): hence the comma.
-    const int row_iteration = std::atoi(line.c_str());
-    const bool whole_iteration = line.find(',') != std::string::npos;
-    if (whole_iteration && row_iteration > 0 && row_iteration <= iteration) {
-      const std::vector<std::string> fields = SplitFields(line);
-      kept << line;
-      for (size_t c = fields.size(); c < columns.size(); ++c) kept << ',';
-      kept << "\n";
-      if (fields.size() > wall_time_column)
-        last.wall_time_s = std::atof(fields[wall_time_column].c_str());
-      if (fields.size() > learning_rate_column)
-        last.learning_rate = std::atof(fields[learning_rate_column].c_str());
-    }
-  }
-  WriteFileAtomic(path, kept.str());
-  return last;
-}
-
 // Wall times beyond a century are corrupt (checkpoints written before a fix
 // read the double's bits as int64: 4.66e18 s).
 bool PlausibleWallTime(double seconds) {
   return std::isfinite(seconds) && seconds >= 0 && seconds < 3.2e9;
 }
-
-// A visited state offered to the ASI buffers.
-struct CapturedState {
-  int buffer = 0;  // InitialStates::BufferOf(the episode's view)
-  int frame = 0;
-  SimState state;
-};
 
 }  // namespace
 
@@ -111,17 +44,14 @@ struct Trainer::State {
   std::shared_ptr<const TrackingReference> reference;
   std::shared_ptr<InitialStates> initial_states;
   std::unique_ptr<VecEnv> envs;
-  std::unique_ptr<TrackingEnv> scoring_env;  // for rescoring ASI entries
+  std::unique_ptr<AsiUpdater> asi;  // with asi.enabled
   ActorCritic model{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer;
   torch::Generator generator;
-  std::mt19937_64 rng;
   SimState state_template;
   CheckpointCounters counters;
   int torch_threads = 1;
   std::unique_ptr<ThreadTuner> thread_tuner;  // with adapt_torch_threads
-  std::vector<CapturedState> captured;
-  std::vector<float> captured_observations;
 
   // Adam's rate, kept in its parameter groups (and so in checkpoints).
   double LearningRate() const {
@@ -135,7 +65,9 @@ struct Trainer::State {
     return config.ppo.normalize_observations ? model->Normalize(raw) : raw;
   }
   void Collect(RolloutStorage& storage, std::vector<FinishedEpisode>* finished);
-  void UpdateStateBuffers();
+  torch::Tensor CriticValue(const torch::Tensor& raw) {
+    return model->Value(Normalized(raw));
+  }
   void Save() {
     m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
                         initial_states.get(), state_template);
@@ -164,7 +96,6 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   }
   torch::manual_seed(run.seed);
   s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
-  s.rng.seed(run.seed);
 
   // Outline: character and references -> initial states -> environments ->
   // networks and optimizer -> (resume) checkpoint -> log.
@@ -180,9 +111,11 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
-  s.scoring_env =
-      std::make_unique<TrackingEnv>(s.character, s.reference, s.initial_states,
-                                    config.env, run.seed + 1'000'003);
+  if (config.asi.enabled) {
+    s.asi =
+        std::make_unique<AsiUpdater>(s.character, s.reference, s.initial_states,
+                                     config.env, config.asi, run.seed);
+  }
   s.state_template = s.envs->env(0).simulation().Save();
   s.model = ActorCritic(s.envs->layout(), config.model, s.envs->action_size());
   s.optimizer = std::make_unique<torch::optim::Adam>(
@@ -209,7 +142,8 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
       torch::NoGradGuard no_grad;
       s.model->LogStd().fill_(std::log(config.model.action_std));
     }
-    const LastLogRow last_row = TrimLog(s.log_path, s.counters.iteration);
+    const LastLogRow last_row =
+        TrainingLog::TrimTo(s.log_path, s.counters.iteration);
     // A fixed rate is a setting; an adaptive one is training state and
     // continues from where it was (from the log for older checkpoints).
     if (config.ppo.target_kl > 0) {
@@ -236,7 +170,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     if (resume)
       spdlog::warn("--resume: no checkpoint at {}; starting fresh",
                    s.checkpoint_path);
-    WriteFileAtomic(s.log_path, std::string(kLogHeader) + "\n");
+    TrainingLog::Start(s.log_path);
   }
   WriteFileAtomic(run.run_dir + "/config.yaml", TrainConfigToYaml(config));
 }
@@ -262,8 +196,7 @@ void Trainer::State::Collect(RolloutStorage& storage,
   const int action_size = vec.action_size();
   const int steps = config.ppo.steps_per_env;
   const double discount = config.ppo.discount;
-  captured.clear();
-  captured_observations.clear();
+  if (asi) asi->BeginRollout();
 
   for (int t = 0; t < steps; ++t) {
     torch::Tensor raw =
@@ -303,18 +236,7 @@ void Trainer::State::Collect(RolloutStorage& storage,
     }
     storage.rewards[t].copy_(reward);
 
-    if (config.asi.enabled && t % config.asi.capture_every_steps == 0) {
-      for (int i = 0; i < num_envs; ++i) {
-        if (vec.terminated()[i] || vec.truncated()[i]) continue;
-        TrackingEnv& env = vec.env(i);
-        captured.push_back({initial_states->BufferOf(env.episode().view_index),
-                            env.frame(), env.simulation().Save()});
-        const float* row =
-            vec.observations() + static_cast<size_t>(i) * observation_size;
-        captured_observations.insert(captured_observations.end(), row,
-                                     row + observation_size);
-      }
-    }
+    if (asi) asi->Capture(vec, t);
   }
   torch::Tensor last_raw =
       torch::from_blob(vec.observations(), {num_envs, observation_size});
@@ -322,59 +244,6 @@ void Trainer::State::Collect(RolloutStorage& storage,
   ComputeGae(storage.rewards, storage.values, storage.dones, last_values,
              discount, config.ppo.gae_lambda, &storage.advantages,
              &storage.returns);
-}
-
-void Trainer::State::UpdateStateBuffers() {
-  // ASI: the critic scores the captured visited states; each replaces the
-  // lowest-scoring state of its frame if it scores higher. Every few
-  // iterations all kept states are rescored, since the critic moves.
-  torch::NoGradGuard no_grad;
-  const int observation_size = envs->observation_size();
-  if (!captured.empty()) {
-    torch::Tensor raw = torch::from_blob(
-        captured_observations.data(),
-        {static_cast<int64_t>(captured.size()), observation_size});
-    torch::Tensor scores =
-        model->Value(Normalized(raw)).to(torch::kDouble).contiguous();
-    const double* score = scores.data_ptr<double>();
-    for (size_t i = 0; i < captured.size(); ++i) {
-      initial_states->buffer(captured[i].buffer)
-          .Insert(captured[i].frame, captured[i].state, score[i]);
-    }
-  }
-  constexpr int kRescoreEveryIterations = 10;
-  if (counters.iteration % kRescoreEveryIterations != 0) return;
-  std::vector<float> observation(observation_size);
-  const std::vector<TrackedView>& views = reference->views();
-  for (int b = 0; b < initial_states->num_buffers(); ++b) {
-    // A state is scored as seen from one of the views its buffer serves.
-    std::vector<int> bundle_views;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (initial_states->BufferOf(static_cast<int>(v)) == b)
-        bundle_views.push_back(static_cast<int>(v));
-    }
-    StateBuffer& buffer = initial_states->buffer(b);
-    std::vector<float> batch;
-    std::vector<std::pair<int, int>> slots;
-    for (int f = 0; f < buffer.num_frames(); ++f) {
-      for (int i = 0; i < buffer.size(f); ++i) {
-        int view = bundle_views[std::uniform_int_distribution<size_t>(
-            0, bundle_views.size() - 1)(rng)];
-        scoring_env->ResetTo(view, f, buffer.entry(f, i).state,
-                             observation.data());
-        batch.insert(batch.end(), observation.begin(), observation.end());
-        slots.push_back({f, i});
-      }
-    }
-    torch::Tensor raw = torch::from_blob(
-        batch.data(), {static_cast<int64_t>(slots.size()), observation_size});
-    torch::Tensor scores =
-        model->Value(Normalized(raw)).to(torch::kDouble).contiguous();
-    for (size_t k = 0; k < slots.size(); ++k) {
-      buffer.Rescore(slots[k].first, slots[k].second,
-                     scores.data_ptr<double>()[k]);
-    }
-  }
 }
 
 TrainSummary Trainer::Run(
@@ -388,8 +257,7 @@ TrainSummary Trainer::Run(
                          s.envs->observation_size(), s.envs->action_size());
   s.envs->Reset();
   Clock::time_point last_checkpoint = Clock::now();
-  std::ofstream log(s.log_path, std::ios::app);
-  if (!log) throw InputError(s.log_path, "cannot open the training log");
+  TrainingLog log(s.log_path);
 
   while (s.counters.samples < config.run.total_samples) {
     if (stop != nullptr && stop->load()) {
@@ -436,7 +304,11 @@ TrainSummary Trainer::Run(
     // 3. Refresh the initial-state buffers (ASI).
     Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;
-    if (config.asi.enabled) s.UpdateStateBuffers();
+    if (s.asi) {
+      s.asi->Update(
+          [&](const torch::Tensor& raw) { return s.CriticValue(raw); },
+          s.counters.iteration);
+    }
     double asi_s = SecondsSince(asi_start);
 
     // 4. Report.
@@ -472,23 +344,7 @@ TrainSummary Trainer::Run(
     progress.approx_kl = losses.approx_kl;
     progress.clip_fraction = losses.clip_fraction;
     progress.learning_rate = learning_rate;
-    log << progress.iteration << ',' << progress.samples << ','
-        << progress.wall_time_s << ',' << progress.samples_per_s << ','
-        << progress.mean_return << ',' << progress.mean_episode_length << ','
-        << progress.succ << ',' << progress.e2d_px << ','
-        << progress.policy_loss << ',' << progress.value_loss << ','
-        << progress.entropy << ',' << progress.learning_rate << ','
-        << progress.approx_kl << ',' << progress.clip_fraction << ','
-        << progress.torch_threads << '\n';
-    log.flush();
-    if (!log) {
-      // A full disk: stop with the last checkpoint intact rather than train
-      // on with rows silently missing from the log.
-      throw InputError(s.log_path,
-                       "cannot append to the training log "
-                       "(disk full?); the last checkpoint is "
-                       "intact, resume with --resume");
-    }
+    log.Append(progress);
     if (on_progress) on_progress(progress);
     summary.last = progress;
     ++summary.iterations_run;

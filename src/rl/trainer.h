@@ -10,26 +10,9 @@
 #include <string>
 
 #include "rl/train_config.h"
+#include "rl/training_log.h"
 
 namespace m2d {
-
-// One row of the training log (train_log.csv).
-struct TrainProgress {
-  int iteration = 0;
-  int64_t samples = 0;
-  double wall_time_s = 0.0;    // across resumed runs
-  double samples_per_s = 0.0;  // end to end, this iteration
-  double mean_return = 0.0;    // finished episodes of this iteration
-  double mean_episode_length = 0.0;
-  double succ = 0.0;    // fraction not ended by early exit
-  double e2d_px = 0.0;  // mean 2D error of those episodes
-  double policy_loss = 0.0, value_loss = 0.0, entropy = 0.0;
-  double approx_kl = 0.0;      // PPO update: mean KL(old || new) estimate
-  double clip_fraction = 0.0;  // and the share of clipped ratios
-  double learning_rate = 0.0;
-  double collect_s = 0.0, update_s = 0.0, asi_s = 0.0;  // time split
-  int torch_threads = 1;  // LibTorch threads this iteration ran with
-};
 
 struct TrainSummary {
   TrainProgress last;
