@@ -3,7 +3,7 @@
 // member, the range it may take and what it means. Range checks
 // (CheckRanges, called by Validate()), reading and writing YAML
 // (yaml_fields.h: ReadFields, WriteFields) and the reference table of every
-// setting (SettingsReference) all walk that one list.
+// setting (yaml_fields.h: AppendSettingRows) all walk that one list.
 //
 //   struct RunOptions {
 //     int env_threads = 2;  // OpenMP threads stepping environments
@@ -20,7 +20,7 @@
 // section by calling the member's VisitFields with the same visitor.
 // Enums used as settings provide, found by argument-dependent lookup,
 // `const char* SettingName(E)`, `bool ParseSetting(const std::string&, E*)`
-// and `std::string SettingChoices(E)` ("a|b|c").
+// and `std::string SettingChoices(E)` ("a, b, c").
 #ifndef MIMIC2D_COMMON_SETTINGS_H_
 #define MIMIC2D_COMMON_SETTINGS_H_
 

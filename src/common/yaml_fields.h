@@ -70,7 +70,7 @@ class YamlFieldReader {
 
   template <typename T>
   void operator()(const char* key, T& value, const Range& range,
-                  const char* /*meaning*/) {
+                  const char* meaning) {
     if constexpr (std::is_enum_v<T>) {
       std::string name = SettingName(value);
       section_.Optional(key, &name);
@@ -78,13 +78,11 @@ class YamlFieldReader {
         section_.Fail(key, "must be one of " + SettingChoices(value));
     } else {
       section_.Optional(key, &value);
-      if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
-        CheckRange(key, static_cast<double>(value), range);
-      } else if constexpr (IsVector<T>::value) {
-        if constexpr (std::is_arithmetic_v<typename T::value_type>) {
-          for (const auto& element : value)
-            CheckRange(key, static_cast<double>(element), range);
-        }
+      // The same check Validate() runs, named here by file and key.
+      try {
+        RangeChecker("")(key, value, range, meaning);
+      } catch (const ConfigError&) {
+        section_.Fail(key, "must be in " + range.ToString());
       }
     }
   }
@@ -97,10 +95,6 @@ class YamlFieldReader {
   }
 
  private:
-  void CheckRange(const char* key, double value, const Range& range) const {
-    if (!range.Contains(value))
-      section_.Fail(key, "must be in " + range.ToString());
-  }
   YamlSection& section_;
 };
 
