@@ -100,6 +100,80 @@ struct FrameCost {
   }
 };
 
+// One limb of one frame with everything else held (the limb search, stage
+// 1b): a single block, the limb's hinge angles. Residuals: the limb's
+// keypoints' reprojection as in FrameCost, each sole point's penetration,
+// and the prior toward rest on the limb's hinges. Differentiating only the
+// few limb angles keeps the many small solves of the search cheap.
+struct LimbCost {
+  const KinematicModel* model;
+  std::vector<int> limb_hinges;              // indices into `hinges_rad`
+  std::vector<int> keypoints;                // the limb's, layout indices
+  std::vector<Eigen::Vector2d> observed_px;  // per limb keypoint
+  std::vector<double> weights;               // per limb keypoint
+  std::vector<double> hinges_rad;            // the frame's, all of them
+  double root_m[3] = {0, 0, 0};
+  double quaternion_wxyz[4] = {1, 0, 0, 0};
+  double focal_px = 1.0;
+  double pitch_roll_rad[2] = {0, 0};
+  double centre_m[3] = {0, 0, 0};
+  double cx_px = 0.0, cy_px = 0.0;
+  double inv_scale_px = 1.0;
+  double sigma = 0.5;
+  double penetration_weight = 0.0;
+  double prior_weight = 0.0;
+
+  int NumResiduals() const {
+    return 2 * static_cast<int>(keypoints.size()) + model->num_sole_points() +
+           static_cast<int>(limb_hinges.size());
+  }
+
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residuals) const {
+    constexpr int kMaxPoints = 128, kMaxHinges = 128;
+    T hinges[kMaxHinges];
+    for (size_t h = 0; h < hinges_rad.size(); ++h) hinges[h] = T(hinges_rad[h]);
+    for (size_t i = 0; i < limb_hinges.size(); ++i)
+      hinges[limb_hinges[i]] = blocks[0][i];
+    const T root[3] = {T(root_m[0]), T(root_m[1]), T(root_m[2])};
+    const T quaternion[4] = {T(quaternion_wxyz[0]), T(quaternion_wxyz[1]),
+                             T(quaternion_wxyz[2]), T(quaternion_wxyz[3])};
+    T points[3 * kMaxPoints];
+    CharacterPoints(*model, root, quaternion, hinges, points);
+    const T focal(focal_px);
+    const T pitch_roll[2] = {T(pitch_roll_rad[0]), T(pitch_roll_rad[1])};
+    const T centre[3] = {T(centre_m[0]), T(centre_m[1]), T(centre_m[2])};
+    T* out = residuals;
+    for (size_t k = 0; k < keypoints.size(); ++k, out += 2) {
+      T pixel[2];
+      FitProject(focal, pitch_roll, centre, &points[3 * keypoints[k]], cx_px,
+                 cy_px, pixel);
+      for (int c = 0; c < 2; ++c) {
+        const T error = (pixel[c] - T(observed_px[k][c])) * T(inv_scale_px);
+        out[c] = T(weights[k]) * GemanMcClureResidual(error, sigma);
+      }
+    }
+    const int first_sole = model->num_keypoints();
+    for (int s = 0; s < model->num_sole_points(); ++s, ++out) {
+      const T& z = points[3 * (first_sole + s) + 2];
+      *out = z < T(0) ? T(penetration_weight) * z : T(0);
+    }
+    for (size_t i = 0; i < limb_hinges.size(); ++i, ++out)
+      *out = T(prior_weight) * blocks[0][i];
+    return true;
+  }
+
+  static ceres::CostFunction* Create(LimbCost cost) {
+    const int num_limb_hinges = static_cast<int>(cost.limb_hinges.size());
+    const int num_residuals = cost.NumResiduals();
+    auto* function = new ceres::DynamicAutoDiffCostFunction<LimbCost, 8>(
+        new LimbCost(std::move(cost)));
+    function->AddParameterBlock(num_limb_hinges);
+    function->SetNumResiduals(num_residuals);
+    return function;
+  }
+};
+
 // Feet that do not slide (blocks: frame t's root position, quaternion,
 // hinges, then frame t+1's): each sole point's horizontal step, weighted by
 // how surely it is in contact (fixed during a solve).
@@ -244,25 +318,34 @@ struct TurnAccelerationCost {
 
 // weight x log(value / prior) on one element of a block: the focal length
 // (a 1-block), the camera's height (element 2 of its centre).
-template <int kBlockSize, int kIndex>
-struct LogPriorCost {
+// A prior on one number of a block: weight x log(value / prior) for a
+// positive scale (focal length, height), weight x (value - prior) for a
+// quantity that may be zero or negative (an angle).
+enum class PriorScale { kLog, kLinear };
+
+template <int kBlockSize, int kIndex, PriorScale kScale>
+struct ScalarPriorCost {
   double prior;
   double weight;
 
   template <typename T>
   bool operator()(const T* block, T* residual) const {
     using std::log;
-    residual[0] = T(weight) * log(block[kIndex] / T(prior));
+    residual[0] =
+        T(weight) * (kScale == PriorScale::kLog ? log(block[kIndex] / T(prior))
+                                                : block[kIndex] - T(prior));
     return true;
   }
 
   static ceres::CostFunction* Create(double prior, double weight) {
-    return new ceres::AutoDiffCostFunction<LogPriorCost, 1, kBlockSize>(
-        new LogPriorCost{prior, weight});
+    return new ceres::AutoDiffCostFunction<ScalarPriorCost, 1, kBlockSize>(
+        new ScalarPriorCost{prior, weight});
   }
 };
-using FocalPriorCost = LogPriorCost<1, 0>;
-using CameraHeightPriorCost = LogPriorCost<3, 2>;
+using FocalPriorCost = ScalarPriorCost<1, 0, PriorScale::kLog>;
+using CameraHeightPriorCost = ScalarPriorCost<3, 2, PriorScale::kLog>;
+// On (pitch, roll): roll toward level.
+using CameraRollPriorCost = ScalarPriorCost<2, 1, PriorScale::kLinear>;
 
 }  // namespace m2d
 

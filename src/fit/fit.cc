@@ -542,6 +542,13 @@ void BuildProblem(Stage stage, const Observations& obs,
       problem.SetParameterUpperBound(&params.focal_px, 0,
                                      20.0 * focal_prior_px);
     }
+    // Most footage is shot level (a tripod, a person holding a phone
+    // upright); without this a body's sideways lean hides in camera roll.
+    if (options.camera_roll_prior_weight > 0) {
+      problem.AddResidualBlock(
+          CameraRollPriorCost::Create(0.0, options.camera_roll_prior_weight),
+          nullptr, params.pitch_roll_rad);
+    }
     problem.SetParameterLowerBound(params.pitch_roll_rad, 0, -1.3);
     problem.SetParameterUpperBound(params.pitch_roll_rad, 0, 1.3);
     problem.SetParameterLowerBound(params.pitch_roll_rad, 1, -0.7);
@@ -614,6 +621,143 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
   ceres::Solve(solver, &problem, &summary);
   return {summary.initial_cost, summary.final_cost,
           static_cast<int>(summary.iterations.size())};
+}
+
+// Stage 1b: each limb's pose, searched frame by frame from every start of
+// the limb with the trunk, root and camera held (a local solver started
+// from rest does not swing a leg raised forward past the one raised back:
+// both look alike in 2D and the joint limits sit between them). The best
+// distinct candidates of each frame are then chained over the clip by
+// dynamic programming (Viterbi), a change of the limb's hinges between
+// frames costing like motion, so that a limb does not flip between its
+// depth-mirrored solutions from one frame to the next.
+void SearchLimbs(const Observations& obs, const KinematicModel& model,
+                 const std::vector<Limb>& limbs, const FitOptions& options,
+                 Parameters& params) {
+  constexpr int kMaxCandidates = 5;
+  constexpr double kDistinctRad = 0.15;  // closer candidates are one
+  constexpr double kSwitchWeight = 0.3;  // per rad of change per frame
+  constexpr double kMoveWeight = 0.1;    // per rad from the pose before
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.limb_search_iterations;
+  solver.function_tolerance = 1e-4;
+  solver.logging_type = ceres::SILENT;
+  const int num_frames = obs.num_frames;
+  struct Candidate {
+    double cost;
+    std::vector<double> values;  // the limb's hinges
+  };
+  for (const Limb& limb : limbs) {
+    std::vector<std::vector<Candidate>> candidates(num_frames);
+    for (int t = 0; t < num_frames; ++t) {
+      std::vector<double> current;
+      for (int h : limb.hinges) current.push_back(params.hinges_rad[t][h]);
+      double evidence = 0.0;
+      for (int j : limb.keypoints) evidence += obs.Weight(t, j);
+      if (evidence <= 0) {  // nothing seen: keep it, let the chain decide
+        candidates[t].push_back({0.0, current});
+        continue;
+      }
+      // The frame's problem: the limb's keypoints, its hinges free.
+      LimbCost cost;
+      cost.model = &model;
+      cost.limb_hinges = limb.hinges;
+      for (int j : limb.keypoints) {
+        if (obs.Weight(t, j) <= 0) continue;
+        cost.keypoints.push_back(j);
+        cost.observed_px.push_back(obs.Pixel(t, j));
+        cost.weights.push_back(obs.Weight(t, j));
+      }
+      cost.hinges_rad = params.hinges_rad[t];
+      std::copy_n(params.root_m[t].data(), 3, cost.root_m);
+      std::copy_n(params.quaternion_wxyz[t].data(), 4, cost.quaternion_wxyz);
+      cost.focal_px = params.focal_px;
+      std::copy_n(params.pitch_roll_rad, 2, cost.pitch_roll_rad);
+      std::copy_n(params.centre(t), 3, cost.centre_m);
+      cost.cx_px = 0.5 * obs.width_px;
+      cost.cy_px = 0.5 * obs.height_px;
+      cost.inv_scale_px = 1.0 / obs.median_scale_px;
+      cost.sigma = options.reprojection_sigma;
+      cost.penetration_weight = options.penetration_weight;
+      cost.prior_weight = options.pose_prior_weight;
+      std::vector<double> angles = current;
+      ceres::Problem problem;
+      problem.AddResidualBlock(LimbCost::Create(std::move(cost)), nullptr,
+                               angles.data());
+      for (size_t i = 0; i < limb.hinges.size(); ++i) {
+        problem.SetParameterLowerBound(angles.data(), i,
+                                       model.hinge_low_rad[limb.hinges[i]]);
+        problem.SetParameterUpperBound(angles.data(), i,
+                                       model.hinge_high_rad[limb.hinges[i]]);
+      }
+      std::vector<Candidate> found;
+      for (const std::vector<double>& start : limb.starts) {
+        angles = start;
+        ceres::Solver::Summary summary;
+        ceres::Solve(solver, &problem, &summary);
+        // A candidate pays for leaving the pose it was searched from, so a
+        // depth-mirrored twin that fits the 2D no better does not win.
+        double moved = 0.0;
+        for (size_t i = 0; i < angles.size(); ++i) {
+          const double step = kMoveWeight * (angles[i] - current[i]);
+          moved += 0.5 * step * step;
+        }
+        found.push_back({summary.final_cost + moved, angles});
+      }
+      std::sort(found.begin(), found.end(),
+                [](const Candidate& a, const Candidate& b) {
+                  return a.cost < b.cost;
+                });
+      for (Candidate& candidate : found) {
+        bool distinct = true;
+        for (const Candidate& kept : candidates[t]) {
+          double gap = 0.0;
+          for (size_t i = 0; i < kept.values.size(); ++i)
+            gap = std::max(gap, std::abs(kept.values[i] - candidate.values[i]));
+          distinct = distinct && gap > kDistinctRad;
+        }
+        if (distinct) candidates[t].push_back(std::move(candidate));
+        if (static_cast<int>(candidates[t].size()) == kMaxCandidates) break;
+      }
+    }
+    // Viterbi over the frames' candidates.
+    std::vector<std::vector<double>> total(num_frames);
+    std::vector<std::vector<int>> from(num_frames);
+    for (int t = 0; t < num_frames; ++t) {
+      for (const Candidate& candidate : candidates[t]) {
+        double best = 0.0;
+        int best_index = -1;
+        if (t > 0) {
+          best = std::numeric_limits<double>::infinity();
+          for (size_t c = 0; c < candidates[t - 1].size(); ++c) {
+            double change = 0.0;
+            for (size_t i = 0; i < candidate.values.size(); ++i) {
+              const double step =
+                  kSwitchWeight *
+                  (candidate.values[i] - candidates[t - 1][c].values[i]);
+              change += 0.5 * step * step;
+            }
+            if (total[t - 1][c] + change < best) {
+              best = total[t - 1][c] + change;
+              best_index = static_cast<int>(c);
+            }
+          }
+        }
+        total[t].push_back(best + candidate.cost);
+        from[t].push_back(best_index);
+      }
+    }
+    int chosen = static_cast<int>(
+        std::min_element(total.back().begin(), total.back().end()) -
+        total.back().begin());
+    for (int t = num_frames - 1; t >= 0; --t) {
+      const Candidate& candidate = candidates[t][chosen];
+      for (size_t i = 0; i < limb.hinges.size(); ++i)
+        params.hinges_rad[t][limb.hinges[i]] = candidate.values[i];
+      chosen = from[t][chosen];
+    }
+  }
 }
 
 // Mean pixel distance of frame t's confident keypoints from their
@@ -691,6 +835,7 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   }
   const Observations obs = ReadObservations(clip, options, source);
   const RestPose rest = MakeRestPose(model, *clip.layout);
+  const std::vector<Limb> limbs = FindLimbs(model);
   const double focal_prior_px =
       options.fixed_focal_px > 0
           ? options.fixed_focal_px
@@ -743,6 +888,12 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
                 best_turn_deg);
   summary.initialization = label;
 
+  // Stage 1b: each limb searched from a grid of starts, frame by frame.
+  if (options.limb_search_iterations > 0) {
+    SearchLimbs(obs, model, limbs, options, best);
+    say("stage 1b (limb search): " + std::to_string(limbs.size()) + " limbs, " +
+        std::to_string(obs.num_frames) + " frames");
+  }
   // Stage 2 continues: the full pose.
   StageResult pose =
       SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,

@@ -62,6 +62,7 @@ struct FitOptions {
   double camera_speed_weight = 0.5;     // moving centre speed, m per frame
   double focal_prior_weight = 2.0;      // log(focal / prior)
   double upright_weight = 0.5;          // root up axis, horizontal part
+  double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
   // The camera's height is weakly observable when the subject stays at one
   // depth (a following camera): a prior at eye level, log(height / this).
   double camera_height_prior_m = 1.5;
@@ -87,6 +88,7 @@ struct FitOptions {
   int num_facing_starts = 4;
   // Solver: iterations per stage (and per round of stage 3).
   int root_stage_iterations = 20;  // stage 1, per facing start
+  int limb_search_iterations = 5;  // per limb start and frame; 0: off
   int screening_iterations = 10;   // stage 2's screening, per facing start
   int pose_stage_iterations = 50;
   int num_threads = 1;
@@ -139,6 +141,8 @@ struct FitOptions {
       "log(focal / prior at the image diagonal)");
     v("upright_weight", self.upright_weight, weight,
       "horizontal part of the root's up axis");
+    v("camera_roll_prior_weight", self.camera_roll_prior_weight, weight,
+      "camera roll (rad) from level");
     v("camera_height_prior_m", self.camera_height_prior_m, Range::Above(0),
       "camera height prior (m), eye level");
     v("camera_height_prior_weight", self.camera_height_prior_weight, weight,
@@ -156,6 +160,9 @@ struct FitOptions {
       "headings tried for the facing ambiguity");
     v("root_stage_iterations", self.root_stage_iterations,
       Range::Closed(1, 100000), "stage 1 iterations per facing start");
+    v("limb_search_iterations", self.limb_search_iterations,
+      Range::Closed(0, 1000),
+      "stage 1b iterations per limb start and frame (0: no limb search)");
     v("screening_iterations", self.screening_iterations,
       Range::Closed(1, 100000), "stage 2 screening iterations per start");
     v("pose_stage_iterations", self.pose_stage_iterations,

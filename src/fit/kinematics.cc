@@ -122,4 +122,83 @@ Pose3D FittedPose(const Character& character, const double* root_position_m,
   return QposToPose(character, qpos.data());
 }
 
+std::vector<Limb> FindLimbs(const KinematicModel& model) {
+  const int num_joints = static_cast<int>(model.joints.size());
+  std::vector<int> num_children(num_joints, 0);
+  for (const auto& joint : model.joints)
+    if (joint.parent >= 0) ++num_children[joint.parent];
+  auto is_chain_from = [&](int root) {
+    for (int j = root; j < num_joints; ++j) {
+      int a = j;
+      while (a >= 0 && a != root) a = model.joints[a].parent;
+      if (a == root && num_children[j] > 1) return false;
+    }
+    return true;
+  };
+  auto in_subtree = [&](int joint, int root) {
+    for (int a = joint; a >= 0; a = model.joints[a].parent)
+      if (a == root) return true;
+    return false;
+  };
+  std::vector<Limb> limbs;
+  for (int root = 0; root < num_joints; ++root) {
+    const int parent = model.joints[root].parent;
+    if (parent < 0 || num_children[parent] < 2 || !is_chain_from(root))
+      continue;
+    Limb limb;
+    // Joints that move some keypoint of the chain: strict ancestors of a
+    // keypoint's joint, or its own joint when the point is off its centre.
+    std::vector<char> moves(num_joints, 0);
+    for (int k = 0; k < model.num_keypoints(); ++k) {
+      const BodyPoint& point = model.keypoints[k];
+      if (!in_subtree(point.joint, root)) continue;
+      bool moved = false;  // a keypoint at its limb's root stays put
+      for (int a = point.joint; a >= 0; a = model.joints[a].parent) {
+        if (a != point.joint || point.offset_m.norm() > 1e-6) {
+          moves[a] = 1;
+          moved = true;
+        }
+        if (a == root) break;
+      }
+      if (moved) limb.keypoints.push_back(k);
+    }
+    // Each moving joint's hinges and the values its starts take.
+    std::vector<std::vector<double>> axis_values;
+    for (int j = root; j < num_joints; ++j) {
+      const auto& joint = model.joints[j];
+      if (!moves[j] || joint.first_hinge < 0 || !in_subtree(j, root)) continue;
+      const int size = joint.type == JointType::kSpherical ? 3 : 1;
+      for (int i = 0; i < size; ++i) {
+        const int h = joint.first_hinge + i;
+        const double low = model.hinge_low_rad[h],
+                     high = model.hinge_high_rad[h];
+        const double rest = std::clamp(0.0, low, high);
+        std::vector<double> values{rest};
+        if (size == 1) {
+          values.push_back(0.6 * (std::abs(low) > std::abs(high) ? low : high));
+        } else if (i < 2) {
+          values.push_back(0.6 * low);
+          values.push_back(0.6 * high);
+        }
+        limb.hinges.push_back(h);
+        axis_values.push_back(values);
+      }
+    }
+    if (limb.hinges.empty() || limb.keypoints.empty()) continue;
+    limb.starts.push_back({});
+    for (const auto& values : axis_values) {
+      std::vector<std::vector<double>> grown;
+      for (const auto& start : limb.starts) {
+        for (double value : values) {
+          grown.push_back(start);
+          grown.back().push_back(value);
+        }
+      }
+      limb.starts = std::move(grown);
+    }
+    limbs.push_back(std::move(limb));
+  }
+  return limbs;
+}
+
 }  // namespace m2d

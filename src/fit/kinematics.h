@@ -162,6 +162,24 @@ void CharacterPoints(const KinematicModel& model, const T* root_position_m,
   }
 }
 
+// A limb: a chain of joints hanging off the trunk (an arm, a leg, the
+// head), the hinges that move its keypoints, and those keypoints. Its
+// keypoints depend on its own hinges alone once the trunk is placed, so each
+// limb's pose can be searched on its own.
+struct Limb {
+  std::vector<int> hinges;     // indices into a frame's hinge angles
+  std::vector<int> keypoints;  // layout indices
+  std::vector<std::vector<double>> starts;  // limb hinge values per start
+};
+
+// The limbs of `model`: subtrees that are plain chains (no joint in them
+// has two children) under a joint that branches, with at least one
+// keypoint moved by their hinges. Starts: a grid over each moving joint's
+// range (a ball joint's first two axes, twist at rest; a hinge at rest and
+// toward its wider side), so that a limb raised forward, backward or out is
+// near one of them.
+std::vector<Limb> FindLimbs(const KinematicModel& model);
+
 // A fitted frame as the skeleton's Pose3D (the mapping the simulation uses,
 // sim/pose_mapping.h's QposToPose, so the two cannot disagree).
 Pose3D FittedPose(const Character& character, const double* root_position_m,
