@@ -54,6 +54,12 @@ void PpoOptions::Validate() const {
         "agent.adapt_torch_threads needs agent.torch_threads >= 2 (it "
         "chooses between 1 and torch_threads)");
   }
+  if (overlap_update && adapt_torch_threads) {
+    throw ConfigError(
+        "agent.overlap_update and agent.adapt_torch_threads exclude each "
+        "other (with overlap, collection and update each run on one "
+        "LibTorch thread)");
+  }
 }
 
 void AsiOptions::Validate() const { CheckRanges(*this, "asi"); }

@@ -101,6 +101,11 @@ struct PpoOptions {
   // (rl/thread_tuner.h): more threads collapse when another process competes
   // for the cores.
   bool adapt_torch_threads = false;
+  // Learn from the previous batch on a second thread while the next one is
+  // collected (each side with one LibTorch thread): the update works on a
+  // batch one policy update old, which PPO's clipped ratio against the
+  // stored log-probabilities allows (docs/training.md, "Throughput").
+  bool overlap_update = false;
 
   // Every setting (common/settings.h): the config's `agent` section.
   template <typename Self, typename Visitor>
@@ -141,6 +146,9 @@ struct PpoOptions {
     v("adapt_torch_threads", self.adapt_torch_threads, Range::Any(),
       "probe 1 thread against torch_threads while training and keep the "
       "faster");
+    v("overlap_update", self.overlap_update, Range::Any(),
+      "learn from the previous batch on a second thread while collecting "
+      "the next");
   }
   int batch_size() const { return num_envs * steps_per_env; }
   void Validate() const;

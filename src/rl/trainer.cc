@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 
 #include "common/error.h"
 #include "common/file_io.h"
@@ -17,6 +18,7 @@
 #include "motion/bundle.h"
 #include "rl/asi_updater.h"
 #include "rl/checkpoint.h"
+#include "rl/collector.h"
 #include "rl/ppo.h"
 #include "rl/thread_tuner.h"
 
@@ -64,7 +66,20 @@ struct Trainer::State {
   torch::Tensor Normalized(const torch::Tensor& raw) {
     return config.ppo.normalize_observations ? model->Normalize(raw) : raw;
   }
-  void Collect(RolloutStorage& storage, std::vector<FinishedEpisode>* finished);
+  std::unique_ptr<RolloutCollector> collector;
+  // With agent.overlap_update: the policy that acts while `model` learns
+  // (the same weights, one update behind during a collection).
+  ActorCritic behavior{nullptr};
+
+  PpoLosses Learn(const RolloutStorage& batch) {
+    return PpoUpdate(model, *optimizer, batch, config.ppo, generator);
+  }
+  struct Step;
+  Step CollectThenLearn(RolloutStorage& batch);
+  Step CollectWhileLearning(RolloutStorage& next,
+                            const RolloutStorage* previous);
+  void ChooseThreads();
+  void RecordThreads(const Step& step);
   torch::Tensor CriticValue(const torch::Tensor& raw) {
     return model->Value(Normalized(raw));
   }
@@ -87,7 +102,9 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   }
   s.log_path = run.run_dir + "/train_log.csv";
   s.checkpoint_path = run.run_dir + "/checkpoint.pt";
-  s.torch_threads = config.ppo.torch_threads;
+  // With overlap, collection (this thread) and update (a second one) each
+  // run LibTorch on one thread.
+  s.torch_threads = config.ppo.overlap_update ? 1 : config.ppo.torch_threads;
   at::set_num_threads(s.torch_threads);
   if (config.ppo.adapt_torch_threads) {
     ThreadTunerOptions tuner;
@@ -172,6 +189,18 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
                    s.checkpoint_path);
     TrainingLog::Start(s.log_path);
   }
+  // The action noise shares the update's stream, unless the two run at
+  // once (agent.overlap_update): then each has its own.
+  torch::Generator noise_generator = s.generator;
+  if (config.ppo.overlap_update) {
+    noise_generator = at::make_generator<at::CPUGeneratorImpl>(
+        run.seed + 7919 + s.counters.iteration);
+    s.behavior =
+        ActorCritic(s.envs->layout(), config.model, s.envs->action_size());
+    CopyModelState(s.model, s.behavior, true, true);
+  }
+  s.collector =
+      std::make_unique<RolloutCollector>(*s.envs, config.ppo, noise_generator);
   WriteFileAtomic(run.run_dir + "/config.yaml", TrainConfigToYaml(config));
 }
 
@@ -183,68 +212,120 @@ const std::string& Trainer::checkpoint_path() const {
 
 void Trainer::SaveCheckpoint() { state_->Save(); }
 
-void Trainer::State::Collect(RolloutStorage& storage,
-                             std::vector<FinishedEpisode>* finished) {
-  // Outline per step: normalize observations, sample actions from the
-  // Gaussian policy, step every environment in parallel, fold the value of
-  // truncated episodes' last observations into their reward, offer visited
-  // states to ASI.
-  torch::NoGradGuard no_grad;
-  VecEnv& vec = *envs;
-  const int num_envs = vec.num_envs();
-  const int observation_size = vec.observation_size();
-  const int action_size = vec.action_size();
-  const int steps = config.ppo.steps_per_env;
-  const double discount = config.ppo.discount;
-  if (asi) asi->BeginRollout();
+// One iteration's collection and update: what was learned (nothing in an
+// overlapped run's first iteration) and how long each side took.
+struct Trainer::State::Step {
+  std::vector<FinishedEpisode> finished;
+  bool learned = false;
+  PpoLosses losses;
+  double collect_s = 0.0, update_s = 0.0;
+};
 
-  for (int t = 0; t < steps; ++t) {
-    torch::Tensor raw =
-        torch::from_blob(vec.observations(), {num_envs, observation_size});
-    if (config.ppo.normalize_observations) model->UpdateNormalizer(raw);
-    torch::Tensor obs = Normalized(raw);
-    torch::Tensor mean = model->ActionMean(obs);
-    torch::Tensor value = model->Value(obs);
-    torch::Tensor noise = at::randn({num_envs, action_size}, generator);
-    torch::Tensor action = (mean + model->LogStd().exp() * noise).contiguous();
-    storage.observations[t].copy_(obs);
-    storage.actions[t].copy_(action);
-    storage.log_probs[t].copy_(model->LogProb(mean, action));
-    storage.values[t].copy_(value);
-    std::memcpy(vec.actions(), action.data_ptr<float>(),
-                sizeof(float) * num_envs * action_size);
-
-    vec.Step(finished);
-
-    torch::Tensor reward =
-        torch::from_blob(const_cast<float*>(vec.rewards()), {num_envs}).clone();
-    std::vector<int64_t> truncated_rows;
-    for (int i = 0; i < num_envs; ++i) {
-      storage.dones[t][i] =
-          (vec.terminated()[i] || vec.truncated()[i]) ? 1.0f : 0.0f;
-      if (vec.truncated()[i]) truncated_rows.push_back(i);
-    }
-    if (!truncated_rows.empty()) {
-      // Time limits are not failures: bootstrap with V(last observation).
-      torch::Tensor rows = torch::tensor(truncated_rows, torch::kLong);
-      torch::Tensor final_raw =
-          torch::from_blob(const_cast<float*>(vec.final_observations()),
-                           {num_envs, observation_size})
-              .index_select(0, rows);
-      reward.index_add_(0, rows,
-                        discount * model->Value(Normalized(final_raw)));
-    }
-    storage.rewards[t].copy_(reward);
-
-    if (asi) asi->Capture(vec, t);
-  }
-  torch::Tensor last_raw =
-      torch::from_blob(vec.observations(), {num_envs, observation_size});
-  torch::Tensor last_values = model->Value(Normalized(last_raw));
-  ComputeGae(storage.rewards, storage.values, storage.dones, last_values,
-             discount, config.ppo.gae_lambda, &storage.advantages,
-             &storage.returns);
+Trainer::State::Step Trainer::State::CollectThenLearn(RolloutStorage& batch) {
+  Step step;
+  Clock::time_point start = Clock::now();
+  collector->Collect(model, asi.get(), batch, &step.finished);
+  step.collect_s = SecondsSince(start);
+  start = Clock::now();
+  step.losses = Learn(batch);
+  step.update_s = SecondsSince(start);
+  step.learned = true;
+  return step;
 }
+
+Trainer::State::Step Trainer::State::CollectWhileLearning(
+    RolloutStorage& next, const RolloutStorage* previous) {
+  // The behavior copy collects `next` on this thread while the model learns
+  // from `previous` on a second one. PPO's ratio is taken against the
+  // log-probabilities stored at collection, so a batch one update old is
+  // still a valid sample (the clip bounds the step). Then the behavior
+  // takes the new weights, and the model the normalizer statistics the
+  // collection updated.
+  Step step;
+  std::thread learner;
+  if (previous != nullptr) {
+    learner = std::thread([&] {
+      at::set_num_threads(1);
+      const Clock::time_point start = Clock::now();
+      step.losses = Learn(*previous);
+      step.update_s = SecondsSince(start);
+    });
+  }
+  const Clock::time_point start = Clock::now();
+  collector->Collect(behavior, asi.get(), next, &step.finished);
+  step.collect_s = SecondsSince(start);
+  if (learner.joinable()) learner.join();
+  step.learned = previous != nullptr;
+  CopyModelState(model, behavior, /*parameters=*/true, /*buffers=*/false);
+  CopyModelState(behavior, model, /*parameters=*/false, /*buffers=*/true);
+  return step;
+}
+
+void Trainer::State::ChooseThreads() {
+  if (!thread_tuner) return;
+  const int threads = thread_tuner->ThreadsForNextIteration();
+  if (threads != torch_threads) {
+    torch_threads = threads;
+    at::set_num_threads(threads);
+  }
+}
+
+void Trainer::State::RecordThreads(const Step& step) {
+  if (!thread_tuner) return;
+  const int previous = thread_tuner->chosen_threads();
+  const double previous_s = thread_tuner->chosen_seconds_per_sample();
+  if (thread_tuner->Record(torch_threads, (step.collect_s + step.update_s) /
+                                              config.ppo.batch_size())) {
+    spdlog::info(
+        "LibTorch threads {} -> {}: {:.0f} -> {:.0f} samples/s (collect + "
+        "update)",
+        previous, torch_threads, 1.0 / previous_s,
+        1.0 / thread_tuner->chosen_seconds_per_sample());
+  }
+}
+
+namespace {
+
+// The log row of an iteration: counters, timing, the episodes that ended,
+// the update's losses.
+TrainProgress MakeProgress(const CheckpointCounters& counters,
+                           const Trainer::IterationTiming& timing,
+                           const std::vector<FinishedEpisode>& finished,
+                           const PpoLosses& losses, double learning_rate,
+                           int torch_threads, int batch_size) {
+  TrainProgress progress;
+  progress.iteration = counters.iteration;
+  progress.samples = counters.samples;
+  progress.wall_time_s = counters.wall_time_s;
+  progress.samples_per_s = batch_size / timing.iteration_s;
+  progress.collect_s = timing.collect_s;
+  progress.update_s = timing.update_s;
+  progress.asi_s = timing.asi_s;
+  progress.torch_threads = torch_threads;
+  if (!finished.empty()) {
+    double returns = 0, lengths = 0, successes = 0, errors = 0;
+    for (const FinishedEpisode& episode : finished) {
+      returns += episode.stats.total_reward;
+      lengths += episode.stats.steps;
+      successes += episode.stats.failed ? 0.0 : 1.0;
+      errors += episode.stats.mean_error_px();
+    }
+    const double count = static_cast<double>(finished.size());
+    progress.mean_return = returns / count;
+    progress.mean_episode_length = lengths / count;
+    progress.succ = successes / count;
+    progress.e2d_px = errors / count;
+  }
+  progress.policy_loss = losses.policy_loss;
+  progress.value_loss = losses.value_loss;
+  progress.entropy = losses.entropy;
+  progress.approx_kl = losses.approx_kl;
+  progress.clip_fraction = losses.clip_fraction;
+  progress.learning_rate = learning_rate;
+  return progress;
+}
+
+}  // namespace
 
 TrainSummary Trainer::Run(
     int max_iterations, const std::atomic<bool>* stop,
@@ -253,8 +334,15 @@ TrainSummary Trainer::Run(
   const TrainConfig& config = s.config;
   TrainSummary summary;
   summary.checkpoint_path = s.checkpoint_path;
-  RolloutStorage storage(config.ppo.steps_per_env, config.ppo.num_envs,
+  const bool overlap = config.ppo.overlap_update;
+  // The batch being collected and (with overlap) the one being learned from.
+  std::vector<RolloutStorage> batches;
+  for (int b = 0; b < (overlap ? 2 : 1); ++b) {
+    batches.emplace_back(config.ppo.steps_per_env, config.ppo.num_envs,
                          s.envs->observation_size(), s.envs->action_size());
+  }
+  int collecting = 0;
+  bool batch_waiting = false;  // overlap: a collected batch not learned yet
   s.envs->Reset();
   Clock::time_point last_checkpoint = Clock::now();
   TrainingLog log(s.log_path);
@@ -265,90 +353,47 @@ TrainSummary Trainer::Run(
       break;
     }
     if (max_iterations > 0 && summary.iterations_run >= max_iterations) break;
-    // 0. LibTorch's thread count (adaptive: the tuner's pick or probe).
-    if (s.thread_tuner) {
-      const int threads = s.thread_tuner->ThreadsForNextIteration();
-      if (threads != s.torch_threads) {
-        s.torch_threads = threads;
-        at::set_num_threads(threads);
-      }
-    }
-    // 1. Collect a batch of experience.
-    Clock::time_point start = Clock::now();
-    std::vector<FinishedEpisode> finished;
-    s.Collect(storage, &finished);
-    double collect_s = SecondsSince(start);
-    // 2. Learn from it (and, if adaptive, set the next update's rate).
-    Clock::time_point update_start = Clock::now();
+    const Clock::time_point start = Clock::now();
     const double learning_rate = s.LearningRate();
-    PpoLosses losses =
-        PpoUpdate(s.model, *s.optimizer, storage, config.ppo, s.generator);
-    if (config.ppo.target_kl > 0) {
+    // 0. LibTorch's thread count (adaptive: the tuner's pick or probe).
+    s.ChooseThreads();
+    // 1-2. Collect a batch of experience and learn from it (overlapped:
+    // learn from the previous batch while collecting the next).
+    State::Step step;
+    if (overlap) {
+      step = s.CollectWhileLearning(
+          batches[collecting],
+          batch_waiting ? &batches[1 - collecting] : nullptr);
+      batch_waiting = true;
+      collecting = 1 - collecting;
+    } else {
+      step = s.CollectThenLearn(batches[0]);
+    }
+    if (step.learned && config.ppo.target_kl > 0) {
       s.SetLearningRate(
-          AdaptLearningRate(learning_rate, losses.approx_kl, config.ppo));
+          AdaptLearningRate(learning_rate, step.losses.approx_kl, config.ppo));
     }
-    double update_s = SecondsSince(update_start);
-    if (s.thread_tuner) {
-      const int previous = s.thread_tuner->chosen_threads();
-      const double previous_s = s.thread_tuner->chosen_seconds_per_sample();
-      if (s.thread_tuner->Record(
-              s.torch_threads,
-              (collect_s + update_s) / config.ppo.batch_size())) {
-        spdlog::info(
-            "LibTorch threads {} -> {}: {:.0f} -> {:.0f} samples/s (collect + "
-            "update)",
-            previous, s.torch_threads, 1.0 / previous_s,
-            1.0 / s.thread_tuner->chosen_seconds_per_sample());
-      }
-    }
+    s.RecordThreads(step);
     // 3. Refresh the initial-state buffers (ASI).
-    Clock::time_point asi_start = Clock::now();
+    const Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;
     if (s.asi) {
       s.asi->Update(
           [&](const torch::Tensor& raw) { return s.CriticValue(raw); },
           s.counters.iteration);
     }
-    double asi_s = SecondsSince(asi_start);
-
     // 4. Report.
-    double iteration_s = SecondsSince(start);
+    IterationTiming timing{SecondsSince(start), step.collect_s, step.update_s,
+                           SecondsSince(asi_start)};
     s.counters.samples += config.ppo.batch_size();
-    s.counters.wall_time_s += iteration_s;
-    TrainProgress progress;
-    progress.iteration = s.counters.iteration;
-    progress.samples = s.counters.samples;
-    progress.wall_time_s = s.counters.wall_time_s;
-    progress.samples_per_s = config.ppo.batch_size() / iteration_s;
-    progress.collect_s = collect_s;
-    progress.update_s = update_s;
-    progress.asi_s = asi_s;
-    progress.torch_threads = s.torch_threads;
-    if (!finished.empty()) {
-      double returns = 0, lengths = 0, successes = 0, errors = 0;
-      for (const FinishedEpisode& episode : finished) {
-        returns += episode.stats.total_reward;
-        lengths += episode.stats.steps;
-        successes += episode.stats.failed ? 0.0 : 1.0;
-        errors += episode.stats.mean_error_px();
-      }
-      const double count = static_cast<double>(finished.size());
-      progress.mean_return = returns / count;
-      progress.mean_episode_length = lengths / count;
-      progress.succ = successes / count;
-      progress.e2d_px = errors / count;
-    }
-    progress.policy_loss = losses.policy_loss;
-    progress.value_loss = losses.value_loss;
-    progress.entropy = losses.entropy;
-    progress.approx_kl = losses.approx_kl;
-    progress.clip_fraction = losses.clip_fraction;
-    progress.learning_rate = learning_rate;
+    s.counters.wall_time_s += timing.iteration_s;
+    const TrainProgress progress =
+        MakeProgress(s.counters, timing, step.finished, step.losses,
+                     learning_rate, s.torch_threads, config.ppo.batch_size());
     log.Append(progress);
     if (on_progress) on_progress(progress);
     summary.last = progress;
     ++summary.iterations_run;
-
     // 5. Checkpoint every few minutes.
     if (SecondsSince(last_checkpoint) > 60.0 * config.run.checkpoint_minutes) {
       s.Save();

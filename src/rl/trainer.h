@@ -38,6 +38,13 @@ class Trainer {
   void SaveCheckpoint();
   const std::string& checkpoint_path() const;
 
+  // Seconds of one iteration and of its parts (collection and update run
+  // at once with agent.overlap_update).
+  struct IterationTiming {
+    double iteration_s = 0.0;
+    double collect_s = 0.0, update_s = 0.0, asi_s = 0.0;
+  };
+
  private:
   struct State;
   std::unique_ptr<State> state_;

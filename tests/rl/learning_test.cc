@@ -19,11 +19,13 @@ namespace m2d {
 namespace {
 
 // Calibrated on this machine (see the closing note of the learning issue).
-// Measured: 200k samples in 117 s; frames tracked before the 100 px early
-// exit went from 10.2 (untrained) to 26.8 of 45, E2D from 26.4 to 19.9 px.
+// Measured first: 200k samples in 117 s; frames tracked before the 100 px
+// early exit went from 10.2 (untrained) to 26.8 of 45, E2D from 26.4 to
+// 19.9 px. Measured 2026-11-24 (the environment and trainer as they are
+// now): 33 s, frames 10.6 -> 21.8, E2D 27.0 -> 21.4 px.
 constexpr int64_t kTrainingSamples = 200'000;
-constexpr double kMinSurvivalGain = 1.6;    // measured 2.6x
-constexpr double kMinTrainedFrames = 18.0;  // measured 26.8
+constexpr double kMinSurvivalGain = 1.6;    // measured 2.6x, now 2.06x
+constexpr double kMinTrainedFrames = 18.0;  // measured 26.8, now 21.8
 
 // Small networks and batches so that it learns in CI time.
 void UseCiSizedLearning(const std::string& dir, TrainConfig* config) {
@@ -74,10 +76,19 @@ BeforeAndAfter EvaluateBeforeAndAfter(
   return result;
 }
 
-TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
+// Trains on 2 s of walking seen by 4 following views (with the collection
+// and the update overlapped or not) and checks the policy learned.
+struct LearningThresholds {
+  double min_survival_gain;
+  double min_trained_frames;
+};
+
+void ExpectTheWalkIsLearned(bool overlap_update,
+                            const LearningThresholds& thresholds) {
   const std::string walk_path =
       testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
-  std::string dir = testing::TempDir("learning");
+  std::string dir =
+      testing::TempDir(overlap_update ? "learning_overlap" : "learning");
 
   // The reference: 2 s of walking, 4 following views.
   TrainConfig config;
@@ -89,6 +100,7 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
   config.data.bundles = {dir + "/walk2s.json"};
   WriteBundle(config.data.bundles[0], bundle);
 
+  config.ppo.overlap_update = overlap_update;
   UseCiSizedLearning(dir, &config);
 
   Trainer trainer(config, /*resume=*/false);
@@ -110,9 +122,27 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
       "%.1f px frames %.1f\n",
       before.succ, before.e2d_px, before.mean_frames, after.succ, after.e2d_px,
       after.mean_frames);
-  EXPECT_GT(after.mean_frames, before.mean_frames * kMinSurvivalGain);
-  EXPECT_GT(after.mean_frames, kMinTrainedFrames);
+  EXPECT_GT(after.mean_frames,
+            before.mean_frames * thresholds.min_survival_gain);
+  EXPECT_GT(after.mean_frames, thresholds.min_trained_frames);
   EXPECT_LT(after.e2d_px, before.e2d_px);
+}
+
+TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
+  ExpectTheWalkIsLearned(/*overlap_update=*/false,
+                         {kMinSurvivalGain, kMinTrainedFrames});
+}
+
+// The same run with the update on a second thread, one batch behind the
+// collection (agent.overlap_update). Measured 2026-11-24: frames 10.6 ->
+// 18.3 (1.73x), E2D 27.0 -> 19.7 px, against 21.8 frames and 21.4 px
+// sequentially at the same 200k samples: each update starts one update
+// away from the policy that collected its batch, so the clip bites sooner.
+constexpr double kMinOverlapSurvivalGain = 1.4;  // measured 1.73x
+constexpr double kMinOverlapTrainedFrames = 15;  // measured 18.3
+TEST(Learning, AnOverlappedUpdateLearnsTheWalk) {
+  ExpectTheWalkIsLearned(/*overlap_update=*/true,
+                         {kMinOverlapSurvivalGain, kMinOverlapTrainedFrames});
 }
 
 // Calibrated on this machine (issue 11): the same run from 2D only — the

@@ -159,6 +159,10 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
       "data: {bundles: [a.json]}\nagent: {adapt_torch_threads: true}\n",
       "adapt_torch_threads");
   ExpectConfigError(
+      "data: {bundles: [a.json]}\nagent: {torch_threads: 2, "
+      "adapt_torch_threads: true, overlap_update: true}\n",
+      "overlap_update and agent.adapt_torch_threads exclude each other");
+  ExpectConfigError(
       "data: {bundles: [a.json]}\n"
       "agent: {learning_rate_min: 0.01, learning_rate_max: 0.001}\n",
       "learning_rate_min");
