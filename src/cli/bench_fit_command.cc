@@ -31,6 +31,7 @@ struct BenchFitArgs {
   std::vector<std::string> settings;  // names; empty: all
   std::string noise = "both";         // clean, noisy or both
   bool markdown = false;              // also print the table as Markdown
+  bool from_truth = false;            // also refine from the truth
   bool quick = false;
 };
 
@@ -58,6 +59,7 @@ int RunBenchFit(const BenchFitArgs& args) {
     }
     options.settings = chosen;
   }
+  options.from_truth = args.from_truth;
   options.clean = args.noise != "noisy";
   options.noisy = args.noise != "clean";
   if (args.quick) options.MakeQuick();
@@ -154,6 +156,10 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
           ->capture_default_str();
   fit->add_flag("--markdown", args->markdown,
                 "Also print the table as Markdown (for docs/fit.md)");
+  fit->add_flag("--from-truth", args->from_truth,
+                "Also refine each view from its true camera and poses "
+                "(stages 2-3): the objective's minimum near the truth, and "
+                "the fits whose search missed a lower cost");
   fit->add_flag("--quick", args->quick,
                 "Only the walk, clean 2D, setting A, one view (a smoke test)")
       ->excludes(clips)

@@ -128,6 +128,7 @@ FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
 
   const FitSummary& summary = estimate.summary;
   accuracy.mean_reprojection_px = summary.mean_reprojection_px;
+  accuracy.final_cost = summary.final_cost;
   accuracy.seconds_per_100_frames = 100.0 * summary.seconds / num_frames;
   accuracy.unconverged_fraction =
       static_cast<double>(summary.unconverged_frames.size()) / num_frames;

@@ -42,6 +42,7 @@ struct FitAccuracy {
   double mean_reprojection_px = 0.0;
   double seconds_per_100_frames = 0.0;
   double unconverged_fraction = 0.0;
+  double final_cost = 0.0;  // the fit's objective at its end
   // CPU time of the fit (all threads) scaled to 100 frames (s): robust to
   // other work sharing the cores. Set by a caller that timed the fit (the
   // benchmark); 0 when not measured.

@@ -46,6 +46,10 @@ struct FitBenchmarkOptions {
   double max_duration_s = 4.0;  // clips longer than this are cut
   int num_threads = 1;          // Ceres threads per fit
   FitOptions fit;  // every fit's settings (camera model and threads: above)
+  // Also refine each view from its true camera and poses (fit/fit.h's
+  // RefineView, hinges clamped to their ranges): where the objective's own
+  // minimum near the truth lies, and whether the fit missed a lower cost.
+  bool from_truth = false;
   // Called with a line before each fit and after it (empty: silent).
   std::function<void(const std::string& line)> progress;
 
@@ -64,9 +68,10 @@ struct FitBenchmarkRow {
   std::string setting;
   bool noisy = false;
   int num_frames = 0;
-  std::vector<FitAccuracy> views;   // the views whose fit returned
-  std::vector<std::string> errors;  // views whose fit threw: the message
-  FitAccuracy mean;                 // over `views`
+  std::vector<FitAccuracy> views;       // the views whose fit returned
+  std::vector<FitAccuracy> from_truth;  // with from_truth: per view
+  std::vector<std::string> errors;      // views whose fit threw: the message
+  FitAccuracy mean;                     // over `views`
 };
 
 struct FitBenchmarkResult {
@@ -75,6 +80,11 @@ struct FitBenchmarkResult {
   FitAccuracy all, all_clean, all_noisy;
   int num_fits = 0, num_failed_fits = 0;
   double wall_seconds = 0.0;
+  // With from_truth: the truth-started refinements' means, and the fits
+  // that ended more than 5 % above the refinement's cost (the search
+  // missed a better minimum of the same objective).
+  FitAccuracy from_truth;
+  int num_search_misses = 0;
 };
 
 // Runs the table. The fit reads only each view's 2D clip; the truth is read
@@ -83,7 +93,8 @@ struct FitBenchmarkResult {
 FitBenchmarkResult RunFitBenchmark(const Character& character,
                                    const FitBenchmarkOptions& options);
 
-// A fixed-width text table (one row per combination, then the means).
+// A fixed-width text table (one row per combination, then the means; with
+// from_truth, a line on the truth-started refinements).
 std::string FormatFitBenchmarkTable(const FitBenchmarkResult& result);
 // The same as a markdown table (docs/fit.md).
 std::string FormatFitBenchmarkMarkdown(const FitBenchmarkResult& result);

@@ -16,6 +16,7 @@
 #include "fit/kinematics.h"
 #include "motion/canonical.h"
 #include "sim/character.h"
+#include "sim/pose_mapping.h"
 
 namespace m2d {
 namespace {
@@ -128,6 +129,26 @@ Observations ReadObservations(const Clip2D& clip, const FitOptions& options,
     throw InputError(source, problem);
   }
   return obs;
+}
+
+// The clip's observations, checked to be in the character's layout.
+Observations ReadCharacterObservations(const Clip2D& clip,
+                                       const Character& character,
+                                       const FitOptions& options,
+                                       const std::string& source) {
+  if (clip.layout != &character.keypoint_layout()) {
+    throw InputError(source, "clip layout " + clip.layout->name +
+                                 " differs from the character's " +
+                                 character.keypoint_layout().name);
+  }
+  return ReadObservations(clip, options, source);
+}
+
+// The focal length's prior: the known one, or the image diagonal.
+double FocalPriorPx(const FitOptions& options, const Observations& obs) {
+  return options.fixed_focal_px > 0
+             ? options.fixed_focal_px
+             : std::hypot(static_cast<double>(obs.width_px), obs.height_px);
 }
 
 // Every estimated quantity. Vectors are sized once, so block pointers stay
@@ -799,6 +820,86 @@ std::string DescribeCamera(const Parameters& params) {
   return text;
 }
 
+// Stages 2 and 3 from `best` (the full pose, then contacts), and the
+// estimate with its account: per-frame residuals, the frames that did not
+// converge, the summary.
+ViewEstimate SolvePoseAndReport(const Observations& obs,
+                                const KinematicModel& model,
+                                const KeypointLayout& layout,
+                                const Character& character,
+                                const FitOptions& options,
+                                double focal_prior_px,
+                                std::chrono::steady_clock::time_point started,
+                                FitSummary summary, Parameters& best) {
+  auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
+  // Stage 2 continues: the full pose.
+  StageResult pose =
+      SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
+                 layout, options, focal_prior_px, nullptr, best);
+  summary.iterations += pose.iterations;
+  say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
+      " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
+
+  // Stage 3: feet that do not slide, at the contacts the previous solve
+  // found; relabelled and solved again, since better contacts move the root
+  // and the root's motion sharpens the contacts.
+  StageResult final_stage;
+  for (int round = 0; round < options.contact_rounds; ++round) {
+    if (options.camera_motion == CameraMotion::kMoving) {
+      // Odometry from the height-labelled contacts, then again from
+      // contacts that also stand still once the travel is in: a swing foot
+      // labelled in contact moves fast then, and drops out.
+      for (int pass = 0; pass < kOdometryPasses; ++pass) {
+        const auto points = FramePoints(best, model);
+        RemoveContactSlide(
+            obs, model, layout, points,
+            EstimateContacts(points, model, options, obs.fps, pass > 0), best);
+      }
+    }
+    const ContactWeights contacts = EstimateContacts(
+        FramePoints(best, model), model, options, obs.fps, true);
+    final_stage =
+        SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
+                   model, layout, options, focal_prior_px, &contacts, best);
+    summary.iterations += final_stage.iterations;
+    say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
+        std::to_string(final_stage.initial_cost) + " -> " +
+        std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best));
+  }
+  summary.final_cost = final_stage.final_cost;
+
+  // The estimate and its account.
+  ViewEstimate estimate;
+  estimate.skeleton_name = model.skeleton_name;
+  for (size_t c = 0; c < best.centres_m.size(); ++c) {
+    estimate.cameras.push_back(
+        ToPinholeCamera(best.focal_px, best.pitch_roll_rad,
+                        best.centres_m[c].data(), obs.width_px, obs.height_px));
+  }
+  double weighted_sum = 0.0, weight_total = 0.0;
+  const double unconverged_px =
+      options.unconverged_residual_scale * obs.median_scale_px;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    estimate.poses.push_back(FittedPose(character, best.root_m[t].data(),
+                                        best.quaternion_wxyz[t].data(),
+                                        best.hinges_rad[t].data()));
+    const double residual =
+        FrameResidualPx(obs, model, best, t, &weighted_sum, &weight_total);
+    estimate.residual_px.push_back(residual);
+    if (!obs.usable[t] || residual > unconverged_px)
+      summary.unconverged_frames.push_back(t);
+  }
+  summary.mean_reprojection_px =
+      weight_total > 0 ? weighted_sum / weight_total : 0.0;
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
+          .count();
+  estimate.summary = summary;
+  return estimate;
+}
+
 }  // namespace
 
 bool ParseCameraMotion(const std::string& text, CameraMotion* motion) {
@@ -828,18 +929,11 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   options.Validate();
   const auto started = std::chrono::steady_clock::now();
   const KinematicModel model = KinematicModel::FromCharacter(character);
-  if (clip.layout != &character.keypoint_layout()) {
-    throw InputError(source, "clip layout " + clip.layout->name +
-                                 " differs from the character's " +
-                                 character.keypoint_layout().name);
-  }
-  const Observations obs = ReadObservations(clip, options, source);
+  const Observations obs =
+      ReadCharacterObservations(clip, character, options, source);
   const RestPose rest = MakeRestPose(model, *clip.layout);
   const std::vector<Limb> limbs = FindLimbs(model);
-  const double focal_prior_px =
-      options.fixed_focal_px > 0
-          ? options.fixed_focal_px
-          : std::hypot(static_cast<double>(obs.width_px), obs.height_px);
+  const double focal_prior_px = FocalPriorPx(options, obs);
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
@@ -894,70 +988,85 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
     say("stage 1b (limb search): " + std::to_string(limbs.size()) + " limbs, " +
         std::to_string(obs.num_frames) + " frames");
   }
-  // Stage 2 continues: the full pose.
-  StageResult pose =
-      SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
-                 *clip.layout, options, focal_prior_px, nullptr, best);
-  summary.iterations += pose.iterations;
-  say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
-      " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
+  return SolvePoseAndReport(obs, model, *clip.layout, character, options,
+                            focal_prior_px, started, summary, best);
+}
 
-  // Stage 3: feet that do not slide, at the contacts the previous solve
-  // found; relabelled and solved again, since better contacts move the root
-  // and the root's motion sharpens the contacts.
-  StageResult final_stage;
-  for (int round = 0; round < options.contact_rounds; ++round) {
-    if (options.camera_motion == CameraMotion::kMoving) {
-      // Odometry from the height-labelled contacts, then again from
-      // contacts that also stand still once the travel is in: a swing foot
-      // labelled in contact moves fast then, and drops out.
-      for (int pass = 0; pass < kOdometryPasses; ++pass) {
-        const auto points = FramePoints(best, model);
-        RemoveContactSlide(
-            obs, model, *clip.layout, points,
-            EstimateContacts(points, model, options, obs.fps, pass > 0), best);
-      }
+ViewEstimate RefineView(const Clip2D& clip, const Character& character,
+                        const FitOptions& options,
+                        const std::vector<PinholeCamera>& cameras,
+                        const std::vector<Pose3D>& poses,
+                        const std::string& source) {
+  // Outline: read the observations; express the camera and poses in the
+  // fit's frame (the camera's yaw 0, its first centre above the origin),
+  // with every hinge clamped into its range; stages 2 and 3 as FitView;
+  // report.
+  options.Validate();
+  const auto started = std::chrono::steady_clock::now();
+  const KinematicModel model = KinematicModel::FromCharacter(character);
+  const Observations obs =
+      ReadCharacterObservations(clip, character, options, source);
+  if (static_cast<int>(poses.size()) != obs.num_frames) {
+    throw InputError(source, "the start has " + std::to_string(poses.size()) +
+                                 " poses for " +
+                                 std::to_string(obs.num_frames) + " frames");
+  }
+  if (cameras.empty() || (cameras.size() != 1 &&
+                          static_cast<int>(cameras.size()) != obs.num_frames)) {
+    throw InputError(source, "the start has " + std::to_string(cameras.size()) +
+                                 " cameras; expected 1 or one per frame");
+  }
+  const PinholeCamera& camera = cameras.front();
+  const double focal_prior_px = FocalPriorPx(options, obs);
+  Parameters params;
+  params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
+                                               : camera.intrinsics().fx_px;
+  const Eigen::Vector2d pitch_roll = CameraPitchRollRad(camera);
+  params.pitch_roll_rad[0] = pitch_roll[0];
+  params.pitch_roll_rad[1] = pitch_roll[1];
+  // The world turned about z so that the camera looks along +x, and moved
+  // so that its centre is above the origin.
+  const Eigen::Matrix3d turn =
+      FitCameraRotation(params.pitch_roll_rad).transpose() *
+      camera.rotation_world_to_camera();
+  const Eigen::Vector3d centre = camera.CenterWorld();
+  const Eigen::Vector3d shift(centre.x(), centre.y(), 0.0);
+  // A moving camera keeps its first orientation (the fit's model).
+  for (int c = 0;
+       c <
+       (options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1);
+       ++c) {
+    const PinholeCamera& at = cameras[std::min<size_t>(c, cameras.size() - 1)];
+    params.centres_m.push_back(turn * (at.CenterWorld() - shift));
+  }
+  std::vector<double> qpos(character.model()->nq, 0.0);
+  const Eigen::Quaterniond turn_quaternion(turn);
+  for (const Pose3D& pose : poses) {
+    PoseToQpos(character, pose, qpos.data());
+    params.root_m.push_back(
+        turn * (Eigen::Vector3d(qpos[0], qpos[1], qpos[2]) - shift));
+    const Eigen::Quaterniond root =
+        turn_quaternion *
+        Eigen::Quaterniond(qpos[3], qpos[4], qpos[5], qpos[6]);
+    params.quaternion_wxyz.emplace_back(root.w(), root.x(), root.y(), root.z());
+    std::vector<double> hinges(model.num_hinges());
+    for (int h = 0; h < model.num_hinges(); ++h) {
+      hinges[h] = std::clamp(qpos[character.hinges()[h].qpos_address],
+                             model.hinge_low_rad[h], model.hinge_high_rad[h]);
     }
-    const ContactWeights contacts = EstimateContacts(
-        FramePoints(best, model), model, options, obs.fps, true);
-    final_stage = SolveStage(
-        Stage::kPoseWithContacts, options.pose_stage_iterations, obs, model,
-        *clip.layout, options, focal_prior_px, &contacts, best);
-    summary.iterations += final_stage.iterations;
-    say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
-        std::to_string(final_stage.initial_cost) + " -> " +
-        std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best));
+    params.hinges_rad.push_back(std::move(hinges));
   }
-  summary.final_cost = final_stage.final_cost;
-
-  // The estimate and its account.
-  ViewEstimate estimate;
-  estimate.skeleton_name = model.skeleton_name;
-  for (size_t c = 0; c < best.centres_m.size(); ++c) {
-    estimate.cameras.push_back(
-        ToPinholeCamera(best.focal_px, best.pitch_roll_rad,
-                        best.centres_m[c].data(), obs.width_px, obs.height_px));
-  }
-  double weighted_sum = 0.0, weight_total = 0.0;
-  const double unconverged_px =
-      options.unconverged_residual_scale * obs.median_scale_px;
-  for (int t = 0; t < obs.num_frames; ++t) {
-    estimate.poses.push_back(FittedPose(character, best.root_m[t].data(),
-                                        best.quaternion_wxyz[t].data(),
-                                        best.hinges_rad[t].data()));
-    const double residual =
-        FrameResidualPx(obs, model, best, t, &weighted_sum, &weight_total);
-    estimate.residual_px.push_back(residual);
-    if (!obs.usable[t] || residual > unconverged_px)
-      summary.unconverged_frames.push_back(t);
-  }
-  summary.mean_reprojection_px =
-      weight_total > 0 ? weighted_sum / weight_total : 0.0;
-  summary.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
-          .count();
-  estimate.summary = summary;
-  return estimate;
+  FitSummary summary;
+  summary.camera_model = CameraMotionName(options.camera_motion);
+  summary.focal_fixed = options.fixed_focal_px > 0;
+  summary.num_frames = obs.num_frames;
+  summary.initialization = "the given camera and poses";
+  // The start's cost under stage 2's objective (no iterations).
+  summary.initial_cost = SolveStage(Stage::kPose, 0, obs, model, *clip.layout,
+                                    options, focal_prior_px, nullptr, params)
+                             .initial_cost;
+  return SolvePoseAndReport(obs, model, *clip.layout, character, options,
+                            focal_prior_px, started, summary, params);
 }
 
 ReferenceBundle FitBundle(

@@ -195,6 +195,20 @@ struct FitOptions {
 ViewEstimate FitView(const Clip2D& clip, const Character& character,
                      const FitOptions& options, const std::string& source);
 
+// Stages 2 and 3 of the fit (full pose, then contacts) started from given
+// cameras (1, or one per frame) and poses instead of the fit's own start
+// (hinges clamped into their ranges; the focal held when options.fixed_focal_px
+// says so). For diagnosis: started at the truth (`mimic2d bench fit
+// --from-truth`) it tells a search that misses from an objective whose minimum
+// is off the truth. summary.initial_cost is the start's cost under stage 2's
+// objective. Throws InputError as FitView does, or when `poses` or
+// `cameras` do not match the frames.
+ViewEstimate RefineView(const Clip2D& clip, const Character& character,
+                        const FitOptions& options,
+                        const std::vector<PinholeCamera>& cameras,
+                        const std::vector<Pose3D>& poses,
+                        const std::string& source);
+
 // Fits every view of `bundle` independently (as separate videos would be)
 // and returns the bundle with its `estimate` set. `progress` (optional) is
 // called after each view.

@@ -47,7 +47,8 @@ std::string LineStartingWith(const std::string& text,
 TEST(CliBenchFit, QuickPrintsARowOfFiniteFigures) {
   const std::string dir = testing::TempDir("cli_bench_fit");
   const std::string json_path = dir + "/table.json";
-  const BenchResult result = RunMimic2d("bench fit --quick -o " + json_path);
+  const BenchResult result =
+      RunMimic2d("bench fit --quick --from-truth -o " + json_path);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("[1/1] walk, setting A, clean, view 1/1"),
             std::string::npos)
@@ -75,9 +76,22 @@ TEST(CliBenchFit, QuickPrintsARowOfFiniteFigures) {
   EXPECT_FALSE(LineStartingWith(result.output, "all ").empty())
       << result.output;
 
+  // --from-truth: the refinement from the truth, per view and in a line.
+  EXPECT_NE(result.output.find("    from the truth (cost there "),
+            std::string::npos)
+      << result.output;
+  EXPECT_FALSE(
+      LineStartingWith(result.output, "from the truth (stages 2-3").empty())
+      << result.output;
+
   const nlohmann::json json = ReadJsonFile(json_path);
   EXPECT_EQ(json["format"], "mimic2d.bench_fit");
   ASSERT_EQ(json["rows"].size(), 1u);
+  ASSERT_EQ(json["rows"][0]["from_truth"].size(), 1u);
+  const double truth_started_pa =
+      json["rows"][0]["from_truth"][0]["pa_mpjpe_mm"].get<double>();
+  EXPECT_GT(truth_started_pa, 0.0);
+  EXPECT_LT(truth_started_pa, 60.0);  // the walk: 34 mm when written
   const nlohmann::json& mean = json["rows"][0]["mean"];
   for (const char* key :
        {"focal_error_pct", "pitch_error_deg", "roll_error_deg",
