@@ -69,19 +69,17 @@ double MeasureSimulationBound(const TrainConfig& config, int steps) {
       0.0f, static_cast<float>(config.model.action_std));
   const int num_actions = envs.num_envs() * envs.action_size();
   std::vector<FinishedEpisode> finished;
+  // Returns the seconds of the step alone: drawing the actions is not
+  // simulation.
   auto step = [&] {
-    for (int i = 0; i < num_actions; ++i) envs.actions()[i] = noise(rng);
-    envs.Step(&finished);
-  };
-  for (int warmup = 0; warmup < 20; ++warmup) step();
-  // The actions' draw is timed out: it is not simulation.
-  double simulated_s = 0.0;
-  for (int t = 0; t < steps; ++t) {
     for (int i = 0; i < num_actions; ++i) envs.actions()[i] = noise(rng);
     const Clock::time_point start = Clock::now();
     envs.Step(&finished);
-    simulated_s += std::chrono::duration<double>(Clock::now() - start).count();
-  }
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  for (int warmup = 0; warmup < 20; ++warmup) step();
+  double simulated_s = 0.0;
+  for (int t = 0; t < steps; ++t) simulated_s += step();
   return steps * static_cast<double>(envs.num_envs()) / simulated_s;
 }
 
