@@ -1,6 +1,8 @@
 // cli: `mimic2d bench train` — parses and calls rl/train_benchmark.h
 // (docs/benchmarks.md).
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "cli/commands.h"
 #include "rl/train_benchmark.h"
@@ -12,7 +14,8 @@ void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run) {
   CLI::App* train = bench->add_subcommand(
       "train",
       "End-to-end training samples/s (simulation + inference + PPO update + "
-      "ASI) of a config, per LibTorch thread count and overlapped, against "
+      "ASI) of a config, per LibTorch thread count and precision and "
+      "overlapped, against "
       "its simulation-only bound");
   train->add_option("config", options->config_path, "Training config (YAML)")
       ->required()
@@ -31,13 +34,25 @@ void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run) {
                    "baseline")
       ->delimiter(',')
       ->capture_default_str();
+  auto precisions = std::make_shared<std::vector<std::string>>();
+  train
+      ->add_option("--precision", *precisions,
+                   "Arithmetic precisions to measure at each thread count "
+                   "(fp32, bf16; default: the config's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"fp32", "bf16"}));
   train->add_flag("--overlap,!--no-overlap", options->overlap,
                   "Also measure agent.overlap_update (default on)");
   train
       ->add_option("--bound-steps", options->bound_steps,
                    "Control steps of the simulation-only bound")
       ->capture_default_str();
-  train->callback([run, options] {
+  train->callback([run, options, precisions] {
+    for (const std::string& text : *precisions) {
+      TrainingPrecision precision;
+      ParseSetting(text, &precision);  // CLI::IsMember checked the names
+      options->precisions.push_back(precision);
+    }
     *run = [options] {
       RunTrainBenchmark(*options);
       return 0;

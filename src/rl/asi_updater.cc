@@ -1,18 +1,25 @@
 #include "rl/asi_updater.h"
 
+#include <omp.h>
+
 namespace m2d {
 
 AsiUpdater::AsiUpdater(std::shared_ptr<const Character> character,
                        std::shared_ptr<const TrackingReference> reference,
                        std::shared_ptr<InitialStates> initial_states,
                        const TrackingEnvOptions& env_options,
-                       const AsiOptions& options, uint64_t seed)
+                       const AsiOptions& options, uint64_t seed,
+                       int num_threads)
     : options_(options),
       reference_(reference),
       initial_states_(initial_states),
-      scoring_env_(std::move(character), std::move(reference),
-                   std::move(initial_states), env_options, seed + 1'000'003),
-      rng_(seed) {}
+      rng_(seed) {
+  for (int t = 0; t < std::max(1, num_threads); ++t) {
+    scoring_envs_.push_back(
+        std::make_unique<TrackingEnv>(character, reference, initial_states,
+                                      env_options, seed + 1'000'003 + t));
+  }
+}
 
 void AsiUpdater::BeginRollout() {
   captured_.clear();
@@ -54,8 +61,13 @@ void AsiUpdater::Update(const Critic& critic, int iteration) {
 }
 
 void AsiUpdater::RescoreAll(const Critic& critic) {
-  const int observation_size = scoring_env_.observation_size();
-  std::vector<float> observation(observation_size);
+  // Outline: list every kept entry with the view it is seen from (drawn in
+  // order, so runs are reproducible for any thread count), observe them in
+  // parallel, score them in one critic batch, write the scores back.
+  struct Slot {
+    int buffer, frame, entry, view;
+  };
+  std::vector<Slot> slots;
   const std::vector<TrackedView>& views = reference_->views();
   for (int b = 0; b < initial_states_->num_buffers(); ++b) {
     // A state is scored as seen from one of the views its buffer serves.
@@ -64,26 +76,38 @@ void AsiUpdater::RescoreAll(const Critic& critic) {
       if (initial_states_->BufferOf(static_cast<int>(v)) == b)
         buffer_views.push_back(static_cast<int>(v));
     }
-    StateBuffer& buffer = initial_states_->buffer(b);
-    std::vector<float> batch;
-    std::vector<std::pair<int, int>> slots;
+    const StateBuffer& buffer = initial_states_->buffer(b);
     for (int f = 0; f < buffer.num_frames(); ++f) {
       for (int i = 0; i < buffer.size(f); ++i) {
         int view = buffer_views[std::uniform_int_distribution<size_t>(
             0, buffer_views.size() - 1)(rng_)];
-        scoring_env_.ResetTo(view, f, buffer.entry(f, i).state,
-                             observation.data());
-        batch.insert(batch.end(), observation.begin(), observation.end());
-        slots.push_back({f, i});
+        slots.push_back({b, f, i, view});
       }
     }
-    torch::Tensor raw = torch::from_blob(
-        batch.data(), {static_cast<int64_t>(slots.size()), observation_size});
-    torch::Tensor scores = critic(raw).to(torch::kDouble).contiguous();
-    for (size_t k = 0; k < slots.size(); ++k) {
-      buffer.Rescore(slots[k].first, slots[k].second,
-                     scores.data_ptr<double>()[k]);
-    }
+  }
+  if (slots.empty()) return;
+
+  const int observation_size = scoring_envs_[0]->observation_size();
+  std::vector<float> batch(slots.size() * observation_size);
+  const int num_threads = static_cast<int>(scoring_envs_.size());
+#pragma omp parallel for schedule(static) num_threads(num_threads)
+  for (size_t k = 0; k < slots.size(); ++k) {
+    const Slot& slot = slots[k];
+    scoring_envs_[omp_get_thread_num()]->ResetTo(
+        slot.view, slot.frame,
+        initial_states_->buffer(slot.buffer)
+            .entry(slot.frame, slot.entry)
+            .state,
+        batch.data() + k * observation_size);
+  }
+
+  torch::Tensor raw = torch::from_blob(
+      batch.data(), {static_cast<int64_t>(slots.size()), observation_size});
+  torch::Tensor scores = critic(raw).to(torch::kDouble).contiguous();
+  const double* score = scores.data_ptr<double>();
+  for (size_t k = 0; k < slots.size(); ++k) {
+    initial_states_->buffer(slots[k].buffer)
+        .Rescore(slots[k].frame, slots[k].entry, score[k]);
   }
 }
 

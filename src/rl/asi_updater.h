@@ -27,7 +27,7 @@ class AsiUpdater {
              std::shared_ptr<const TrackingReference> reference,
              std::shared_ptr<InitialStates> initial_states,
              const TrackingEnvOptions& env_options, const AsiOptions& options,
-             uint64_t seed);
+             uint64_t seed, int num_threads);
 
   // Forgets the previous rollout's captures.
   void BeginRollout();
@@ -36,7 +36,7 @@ class AsiUpdater {
   void Capture(VecEnv& envs, int step);
   // Scores the captures into the buffers; on every 10th `iteration` also
   // rescores every kept entry (each seen from a random view its buffer
-  // serves).
+  // serves), observing them on `num_threads` OpenMP threads.
   void Update(const Critic& critic, int iteration);
 
  private:
@@ -50,8 +50,9 @@ class AsiUpdater {
   AsiOptions options_;
   std::shared_ptr<const TrackingReference> reference_;
   std::shared_ptr<InitialStates> initial_states_;
-  TrackingEnv scoring_env_;  // observes kept entries for rescoring
-  std::mt19937_64 rng_;      // the view each entry is rescored from
+  // Observe kept entries for rescoring, one per thread.
+  std::vector<std::unique_ptr<TrackingEnv>> scoring_envs_;
+  std::mt19937_64 rng_;  // the view each entry is rescored from
   std::vector<CapturedState> captured_;
   std::vector<float> captured_observations_;
 };

@@ -33,8 +33,12 @@ void RolloutCollector::Collect(ActorCritic& policy, AsiUpdater* asi,
         torch::from_blob(envs_.observations(), {num_envs, observation_size});
     if (options_.normalize_observations) policy->UpdateNormalizer(raw);
     torch::Tensor obs = normalized(raw);
-    torch::Tensor mean = policy->ActionMean(obs);
-    torch::Tensor value = policy->Value(obs);
+    torch::Tensor mean, value;
+    {
+      PrecisionScope precision(options_.training_precision);
+      mean = policy->ActionMean(obs).to(torch::kFloat);
+      value = policy->Value(obs).to(torch::kFloat);
+    }
     torch::Tensor noise = at::randn({num_envs, action_size}, generator_);
     torch::Tensor action = (mean + policy->LogStd().exp() * noise).contiguous();
     storage.observations[t].copy_(obs);

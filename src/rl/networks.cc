@@ -1,5 +1,7 @@
 #include "rl/networks.h"
 
+#include <ATen/autocast_mode.h>
+
 #include <cmath>
 
 namespace m2d {
@@ -123,6 +125,19 @@ torch::Tensor ActorCriticImpl::LogProb(const torch::Tensor& mean,
 
 torch::Tensor ActorCriticImpl::Entropy() const {
   return (log_std + 0.5 * std::log(2.0 * M_PI * M_E)).sum();
+}
+
+PrecisionScope::PrecisionScope(TrainingPrecision precision)
+    : bf16_(precision == TrainingPrecision::kBf16) {
+  if (!bf16_) return;
+  at::autocast::set_autocast_cpu_dtype(at::kBFloat16);
+  at::autocast::set_cpu_enabled(true);
+}
+
+PrecisionScope::~PrecisionScope() {
+  if (!bf16_) return;
+  at::autocast::set_cpu_enabled(false);
+  at::autocast::clear_cache();
 }
 
 }  // namespace m2d

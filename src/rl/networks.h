@@ -66,6 +66,24 @@ class ActorCriticImpl : public torch::nn::Module {
 };
 TORCH_MODULE(ActorCritic);
 
+// Within its scope (on this thread: autocast state is thread-local), matrix
+// products run in bfloat16 when the precision says so (LibTorch's CPU
+// autocast; oneDNN uses AMX or AVX512-BF16 where the CPU has them); weights
+// stay float32. The collector and the update both act in it, so that the
+// behavior policy's stored log-probabilities and the update's agree: with
+// sigma = 0.05, a mean rounded differently would read as a policy ratio
+// several percent from 1 before any step.
+class PrecisionScope {
+ public:
+  explicit PrecisionScope(TrainingPrecision precision);
+  ~PrecisionScope();
+  PrecisionScope(const PrecisionScope&) = delete;
+  PrecisionScope& operator=(const PrecisionScope&) = delete;
+
+ private:
+  bool bf16_;
+};
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_RL_NETWORKS_H_

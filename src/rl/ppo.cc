@@ -57,7 +57,6 @@ PpoLosses PpoUpdate(ActorCritic& model, torch::optim::Optimizer& optimizer,
   torch::Tensor old_log_probs = storage.log_probs.reshape({batch});
   torch::Tensor advantages = storage.advantages.reshape({batch});
   torch::Tensor returns = storage.returns.reshape({batch});
-
   PpoLosses totals;
   int updates = 0;
   for (int epoch = 0; epoch < options.epochs; ++epoch) {
@@ -66,8 +65,12 @@ PpoLosses PpoUpdate(ActorCritic& model, torch::optim::Optimizer& optimizer,
          start += options.minibatch_size) {
       torch::Tensor index = order.narrow(0, start, options.minibatch_size);
       torch::Tensor obs = observations.index_select(0, index);
-      torch::Tensor mean = model->ActionMean(obs);
-      torch::Tensor value = model->Value(obs);
+      torch::Tensor mean, value;
+      {
+        PrecisionScope precision(options.training_precision);
+        mean = model->ActionMean(obs).to(torch::kFloat);
+        value = model->Value(obs).to(torch::kFloat);
+      }
       torch::Tensor log_prob =
           model->LogProb(mean, actions.index_select(0, index));
 

@@ -23,6 +23,7 @@ using Clock = std::chrono::steady_clock;
 struct Setting {
   std::string label;
   int torch_threads = 1;
+  TrainingPrecision precision = TrainingPrecision::kFp32;
   bool overlap = false;
 };
 
@@ -33,6 +34,7 @@ TrainTiming MeasureTraining(TrainConfig config, const Setting& setting,
                         ("mimic2d_bench_train_" + std::to_string(getpid()));
   config.run.run_dir = scratch;
   config.ppo.torch_threads = setting.torch_threads;
+  config.ppo.training_precision = setting.precision;
   config.ppo.overlap_update = setting.overlap;
   // Each setting is measured as given: the config's thread tuner would
   // switch counts mid-measurement (and rejects 1 thread as its maximum).
@@ -119,19 +121,30 @@ void RunTrainBenchmark(const TrainBenchmarkOptions& options) {
       "simulation-only bound: %.0f samples/s (the same %d environments "
       "stepped with no policy, %d env threads)\n\n",
       bound, config.ppo.num_envs, config.run.env_threads);
+  std::vector<TrainingPrecision> precisions = options.precisions;
+  if (precisions.empty()) precisions = {config.ppo.training_precision};
   std::vector<Setting> settings;
-  for (int threads : options.torch_threads)
-    settings.push_back({std::to_string(threads), threads, false});
-  if (options.overlap) settings.push_back({"overlap (1+1)", 1, true});
-  std::printf("%-14s %10s %9s %9s %9s %9s %9s\n", "torch threads", "samples/s",
-              "collect", "update", "asi", "ratio", "of bound");
+  for (int threads : options.torch_threads) {
+    for (TrainingPrecision precision : precisions) {
+      settings.push_back(
+          {std::to_string(threads) + " " + SettingName(precision), threads,
+           precision, false});
+    }
+  }
+  if (options.overlap) {
+    settings.push_back(
+        {std::string("overlap 1+1 ") + SettingName(precisions.back()), 1,
+         precisions.back(), true});
+  }
+  std::printf("%-18s %10s %9s %9s %9s %9s %9s\n", "threads precision",
+              "samples/s", "collect", "update", "asi", "ratio", "of bound");
   double baseline = 0.0;
   for (const Setting& setting : settings) {
     const TrainTiming timing = MeasureTraining(config, setting, options);
     if (baseline == 0.0) baseline = timing.samples_per_s();
     // Shares of the wall time; with overlap collect + update exceed 100 %.
     const double wall = timing.wall_s;
-    std::printf("%-14s %10.0f %8.0f%% %8.0f%% %8.0f%% %9.2f %9.2f\n",
+    std::printf("%-18s %10.0f %8.0f%% %8.0f%% %8.0f%% %9.2f %9.2f\n",
                 setting.label.c_str(), timing.samples_per_s(),
                 100 * timing.collect_s / wall, 100 * timing.update_s / wall,
                 100 * timing.asi_s / wall, timing.samples_per_s() / baseline,

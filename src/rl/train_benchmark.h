@@ -1,6 +1,7 @@
 // rl: `mimic2d bench train` — end-to-end training throughput of a config
 // (simulation + policy inference + PPO update + ASI) for several LibTorch
-// thread counts and with the update overlapped with collection, against
+// thread counts and arithmetic precisions and with the update overlapped
+// with collection, against
 // the simulation-only bound measured in the same run: the config's own
 // environments stepped with Gaussian actions and no policy, on the
 // config's env threads (docs/benchmarks.md). No LibTorch in this header.
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "rl/train_config.h"
+
 namespace m2d {
 
 struct TrainBenchmarkOptions {
@@ -18,7 +21,10 @@ struct TrainBenchmarkOptions {
   int iterations = 10;                   // timed iterations per setting
   int warmup_iterations = 2;             // untimed iterations first
   std::vector<int> torch_threads{1, 2};  // sequential settings, in order
-  bool overlap = true;                   // also measure agent.overlap_update
+  // Each thread count is measured at each of these (empty: the config's
+  // agent.training_precision); the overlapped row uses the last.
+  std::vector<TrainingPrecision> precisions;
+  bool overlap = true;    // also measure agent.overlap_update
   int bound_steps = 200;  // control steps of the simulation-only bound
   // Throws ConfigError naming the bad option.
   void Validate() const;

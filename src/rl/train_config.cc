@@ -28,6 +28,21 @@ TrackingTaskOptions TrainingTaskOptions(const TrainConfig& config) {
   return options;
 }
 
+const char* SettingName(TrainingPrecision precision) {
+  return precision == TrainingPrecision::kBf16 ? "bf16" : "fp32";
+}
+
+bool ParseSetting(const std::string& text, TrainingPrecision* precision) {
+  for (TrainingPrecision known :
+       {TrainingPrecision::kFp32, TrainingPrecision::kBf16}) {
+    if (text == SettingName(known)) {
+      *precision = known;
+      return true;
+    }
+  }
+  return false;
+}
+
 void ModelOptions::Validate() const {
   CheckRanges(*this, "model");
   // Far above useful depths: a typo (or a damaged checkpoint's config) is

@@ -73,6 +73,19 @@ struct ModelOptions {
   void Validate() const;
 };
 
+// Arithmetic of the networks while training (collection and update).
+enum class TrainingPrecision {
+  kFp32,  // float32 throughout
+  // bfloat16 matrix products (LibTorch's CPU autocast; oneDNN uses AMX or
+  // AVX512-BF16 where the CPU has them) with float32 weights, optimizer
+  // state, log-probabilities and losses. Collection acts in it too, so the
+  // behavior policy is the network the update differentiates.
+  kBf16,
+};
+const char* SettingName(TrainingPrecision precision);
+bool ParseSetting(const std::string& text, TrainingPrecision* precision);
+inline std::string SettingChoices(TrainingPrecision) { return "fp32, bf16"; }
+
 // PPO (CleanRL-style "agent" config). Every field is documented in
 // configs/README.md with the reasoning behind its default.
 struct PpoOptions {
@@ -106,6 +119,7 @@ struct PpoOptions {
   // batch one policy update old, which PPO's clipped ratio against the
   // stored log-probabilities allows (docs/training.md, "Throughput").
   bool overlap_update = false;
+  TrainingPrecision training_precision = TrainingPrecision::kFp32;
 
   // Every setting (common/settings.h): the config's `agent` section.
   template <typename Self, typename Visitor>
@@ -149,6 +163,9 @@ struct PpoOptions {
     v("overlap_update", self.overlap_update, Range::Any(),
       "learn from the previous batch on a second thread while collecting "
       "the next");
+    v("training_precision", self.training_precision, Range::Any(),
+      "arithmetic of the networks' matrix products in collection and "
+      "update: fp32, or bf16 (float32 weights and losses)");
   }
   int batch_size() const { return num_envs * steps_per_env; }
   void Validate() const;

@@ -81,7 +81,8 @@ struct Trainer::State {
   void ChooseThreads();
   void RecordThreads(const Step& step);
   torch::Tensor CriticValue(const torch::Tensor& raw) {
-    return model->Value(Normalized(raw));
+    PrecisionScope precision(config.ppo.training_precision);
+    return model->Value(Normalized(raw)).to(torch::kFloat);
   }
   void Save() {
     m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
@@ -129,9 +130,9 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
   if (config.asi.enabled) {
-    s.asi =
-        std::make_unique<AsiUpdater>(s.character, s.reference, s.initial_states,
-                                     config.env, config.asi, run.seed);
+    s.asi = std::make_unique<AsiUpdater>(s.character, s.reference,
+                                         s.initial_states, config.env,
+                                         config.asi, run.seed, run.env_threads);
   }
   s.state_template = s.envs->env(0).simulation().Save();
   s.model = ActorCritic(s.envs->layout(), config.model, s.envs->action_size());

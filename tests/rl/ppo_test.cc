@@ -90,6 +90,34 @@ TEST(Networks, AveragingIdenticalViewsEqualsOneView) {
                               model->ActionMean(ba, 2), 1e-5, 1e-6));
 }
 
+TEST(Networks, ABf16ScopeRoundsOnlyWithinItAndStaysNearFloat32) {
+  torch::manual_seed(4);
+  ObservationLayout layout = SmallLayout();
+  ModelOptions options;
+  ActorCritic model(layout, options, 4);
+  torch::NoGradGuard no_grad;
+  torch::Tensor obs = torch::randn({64, layout.size()});
+  torch::Tensor fp32 = model->Value(obs);
+  torch::Tensor bf16;
+  {
+    PrecisionScope precision(TrainingPrecision::kBf16);
+    bf16 = model->Value(obs);
+  }
+  EXPECT_EQ(bf16.scalar_type(), torch::kBFloat16);
+  // bfloat16 keeps 8 significant bits: within a few percent, not equal.
+  const double scale = fp32.abs().max().item<double>();
+  const double error =
+      (bf16.to(torch::kFloat) - fp32).abs().max().item<double>();
+  EXPECT_GT(error, 0.0);
+  EXPECT_LT(error, 0.05 * scale);
+  // The scope ends: float32 again, and an fp32 scope changes nothing.
+  EXPECT_EQ(model->Value(obs).scalar_type(), torch::kFloat);
+  {
+    PrecisionScope precision(TrainingPrecision::kFp32);
+    EXPECT_TRUE(torch::equal(model->Value(obs), fp32));
+  }
+}
+
 TEST(Networks, RunningNormalizerTracksMeanAndVariance) {
   RunningNormalizer normalizer(2);
   torch::manual_seed(1);

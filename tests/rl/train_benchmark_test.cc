@@ -26,6 +26,7 @@ TEST(TrainBenchmark, PrintsTheBoundAndARowPerSetting) {
   options.iterations = 2;
   options.warmup_iterations = 1;
   options.torch_threads = {1};
+  options.precisions = {TrainingPrecision::kFp32, TrainingPrecision::kBf16};
   options.bound_steps = 10;
 
   ::testing::internal::CaptureStdout();
@@ -34,8 +35,10 @@ TEST(TrainBenchmark, PrintsTheBoundAndARowPerSetting) {
   std::printf("%s", out.c_str());
   EXPECT_NE(out.find("simulation-only bound: "), std::string::npos);
   EXPECT_NE(out.find("of bound"), std::string::npos);
-  EXPECT_NE(out.find("\n1 "), std::string::npos);
-  EXPECT_NE(out.find("\noverlap (1+1) "), std::string::npos);
+  EXPECT_NE(out.find("\n1 fp32 "), std::string::npos);
+  EXPECT_NE(out.find("\n1 bf16 "), std::string::npos);
+  // The overlapped row runs at the last precision listed.
+  EXPECT_NE(out.find("\noverlap 1+1 bf16 "), std::string::npos);
 
   options.torch_threads.clear();
   options.overlap = false;

@@ -163,6 +163,9 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
       "adapt_torch_threads: true, overlap_update: true}\n",
       "overlap_update and agent.adapt_torch_threads exclude each other");
   ExpectConfigError(
+      "data: {bundles: [a.json]}\nagent: {training_precision: fp16}\n",
+      "'agent.training_precision' must be one of fp32, bf16");
+  ExpectConfigError(
       "data: {bundles: [a.json]}\n"
       "agent: {learning_rate_min: 0.01, learning_rate_max: 0.001}\n",
       "learning_rate_min");
