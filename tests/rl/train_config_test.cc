@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "common/error.h"
@@ -129,6 +130,22 @@ TEST(TrainConfig, TheSettingsReferenceListsEveryEmittedKey) {
   EXPECT_NE(readme.find(table), std::string::npos)
       << "configs/README.md's settings table is stale: replace it with the "
          "output of `build/mimic2d train --list-settings`";
+}
+
+TEST(TrainConfig, EveryShippedConfigLoadsAndValidates) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           std::string(MIMIC2D_SOURCE_DIR) + "/configs")) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(LoadTrainConfig(entry.path().string()));
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 3);  // walk, walk2d, walk2d_fast
+  TrainConfig fast = LoadTrainConfig(std::string(MIMIC2D_SOURCE_DIR) +
+                                     "/configs/walk2d_fast.yaml");
+  EXPECT_EQ(fast.ppo.training_precision, TrainingPrecision::kBf16);
+  EXPECT_EQ(fast.ppo.batch_size(), 2048);
 }
 
 TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
