@@ -34,11 +34,7 @@ void RolloutCollector::Collect(ActorCritic& policy, AsiUpdater* asi,
     if (options_.normalize_observations) policy->UpdateNormalizer(raw);
     torch::Tensor obs = normalized(raw);
     torch::Tensor mean, value;
-    {
-      PrecisionScope precision(options_.training_precision);
-      mean = policy->ActionMean(obs).to(torch::kFloat);
-      value = policy->Value(obs).to(torch::kFloat);
-    }
+    ForwardInPrecision(policy, obs, options_.training_precision, &mean, &value);
     torch::Tensor noise = at::randn({num_envs, action_size}, generator_);
     torch::Tensor action = (mean + policy->LogStd().exp() * noise).contiguous();
     storage.observations[t].copy_(obs);

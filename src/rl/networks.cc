@@ -140,4 +140,12 @@ PrecisionScope::~PrecisionScope() {
   at::autocast::clear_cache();
 }
 
+void ForwardInPrecision(ActorCritic& model, const torch::Tensor& obs,
+                        TrainingPrecision precision, torch::Tensor* mean,
+                        torch::Tensor* value) {
+  PrecisionScope scope(precision);
+  *mean = model->ActionMean(obs).to(torch::kFloat);
+  *value = model->Value(obs).to(torch::kFloat);
+}
+
 }  // namespace m2d

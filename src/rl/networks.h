@@ -84,6 +84,13 @@ class PrecisionScope {
   bool bf16_;
 };
 
+// The Gaussian mean and the value of `obs` (normalized) in the training
+// precision, returned as float32: what the collector acts with and the
+// update differentiates.
+void ForwardInPrecision(ActorCritic& model, const torch::Tensor& obs,
+                        TrainingPrecision precision, torch::Tensor* mean,
+                        torch::Tensor* value);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_RL_NETWORKS_H_

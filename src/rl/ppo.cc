@@ -66,11 +66,7 @@ PpoLosses PpoUpdate(ActorCritic& model, torch::optim::Optimizer& optimizer,
       torch::Tensor index = order.narrow(0, start, options.minibatch_size);
       torch::Tensor obs = observations.index_select(0, index);
       torch::Tensor mean, value;
-      {
-        PrecisionScope precision(options.training_precision);
-        mean = model->ActionMean(obs).to(torch::kFloat);
-        value = model->Value(obs).to(torch::kFloat);
-      }
+      ForwardInPrecision(model, obs, options.training_precision, &mean, &value);
       torch::Tensor log_prob =
           model->LogProb(mean, actions.index_select(0, index));
 

@@ -151,9 +151,10 @@ TEST(Learning, AnOverlappedUpdateLearnsTheWalk) {
 // The same run with bfloat16 matrix products in collection and update
 // (agent.training_precision: bf16). Measured 2026-11-24: frames 10.6 ->
 // 20.8 (1.96x), E2D 27.0 -> 18.5 px, against 21.8 frames and 21.4 px in
-// float32 at the same 200k samples and seed.
-constexpr double kMinBf16SurvivalGain = 1.6;    // measured 1.96x
-constexpr double kMinBf16TrainedFrames = 18.0;  // measured 20.8
+// float32 at the same 200k samples and seed; with ASI's critic also in
+// bfloat16, 25.4 frames and 20.0 px.
+constexpr double kMinBf16SurvivalGain = 1.6;    // measured 1.96x, 2.40x
+constexpr double kMinBf16TrainedFrames = 18.0;  // measured 20.8, 25.4
 TEST(Learning, ABf16UpdateLearnsTheWalk) {
   ExpectTheWalkIsLearned("learning_bf16", /*overlap_update=*/false,
                          TrainingPrecision::kBf16,
