@@ -14,9 +14,8 @@ void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run) {
   CLI::App* train = bench->add_subcommand(
       "train",
       "End-to-end training samples/s (simulation + inference + PPO update + "
-      "ASI) of a config, per LibTorch thread count and precision and "
-      "overlapped, against "
-      "its simulation-only bound");
+      "ASI) of a config, per LibTorch thread count, precision and collection "
+      "mode and overlapped, against its simulation-only bound");
   train->add_option("config", options->config_path, "Training config (YAML)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -41,17 +40,30 @@ void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run) {
                    "(fp32, bf16; default: the config's)")
       ->delimiter(',')
       ->check(CLI::IsMember({"fp32", "bf16"}));
+  auto collections = std::make_shared<std::vector<std::string>>();
+  train
+      ->add_option("--collection", *collections,
+                   "Collection modes to measure at each thread count and "
+                   "precision (batched, per_thread; default: the config's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"batched", "per_thread"}));
   train->add_flag("--overlap,!--no-overlap", options->overlap,
                   "Also measure agent.overlap_update (default on)");
   train
       ->add_option("--bound-steps", options->bound_steps,
                    "Control steps of the simulation-only bound")
       ->capture_default_str();
-  train->callback([run, options, precisions] {
+  train->callback([run, options, precisions, collections] {
+    // CLI::IsMember checked the names.
     for (const std::string& text : *precisions) {
       TrainingPrecision precision;
-      ParseSetting(text, &precision);  // CLI::IsMember checked the names
+      ParseSetting(text, &precision);
       options->precisions.push_back(precision);
+    }
+    for (const std::string& text : *collections) {
+      CollectionMode collection;
+      ParseSetting(text, &collection);
+      options->collections.push_back(collection);
     }
     *run = [options] {
       RunTrainBenchmark(*options);

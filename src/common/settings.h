@@ -24,6 +24,7 @@
 #ifndef MIMIC2D_COMMON_SETTINGS_H_
 #define MIMIC2D_COMMON_SETTINGS_H_
 
+#include <initializer_list>
 #include <limits>
 #include <string>
 #include <type_traits>
@@ -32,6 +33,20 @@
 #include "common/error.h"
 
 namespace m2d {
+
+// ParseSetting for an enum that has SettingName: the one of `values` named
+// `text`; false when none is.
+template <typename E>
+bool ParseSettingByName(const std::string& text,
+                        std::initializer_list<E> values, E* value) {
+  for (E known : values) {
+    if (text == SettingName(known)) {
+      *value = known;
+      return true;
+    }
+  }
+  return false;
+}
 
 // The values a numeric setting may take: an interval whose ends are each
 // open or closed (an infinite end is open). NaN is in no range.

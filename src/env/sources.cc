@@ -1,6 +1,7 @@
 #include "env/sources.h"
 
 #include "common/error.h"
+#include "common/settings.h"
 
 namespace m2d {
 
@@ -49,25 +50,16 @@ CameraSource ParseCameraSource(const std::string& text) {
 }
 
 bool ParseSetting(const std::string& text, InitialStateSource* source) {
-  for (InitialStateSource known :
-       {InitialStateSource::kTruth, InitialStateSource::kEstimate,
-        InitialStateSource::kDefault}) {
-    if (text == SourceName(known)) {
-      *source = known;
-      return true;
-    }
-  }
-  return false;
+  return ParseSettingByName(
+      text,
+      {InitialStateSource::kTruth, InitialStateSource::kEstimate,
+       InitialStateSource::kDefault},
+      source);
 }
 
 bool ParseSetting(const std::string& text, CameraSource* source) {
-  for (CameraSource known : {CameraSource::kTruth, CameraSource::kEstimate}) {
-    if (text == SourceName(known)) {
-      *source = known;
-      return true;
-    }
-  }
-  return false;
+  return ParseSettingByName(
+      text, {CameraSource::kTruth, CameraSource::kEstimate}, source);
 }
 
 std::string DescribeSources(const TaskSources& sources) {

@@ -51,28 +51,39 @@ void VecEnv::Step(std::vector<FinishedEpisode>* finished) {
   // environments (contacts, resets), and every thread waits for the slowest
   // at the end of the loop (docs/benchmarks.md).
 #pragma omp parallel for schedule(dynamic, 1) num_threads(num_threads_)
-  for (int i = 0; i < count; ++i) {
-    float* observation =
-        observations_.data() + static_cast<size_t>(i) * observation_size_;
-    StepOutcome outcome = envs_[i]->Step(
-        actions_.data() + static_cast<size_t>(i) * action_size_, observation);
-    rewards_[i] = outcome.reward;
-    terminated_[i] = outcome.terminated;
-    truncated_[i] = outcome.truncated;
-    finished_flag_[i] = outcome.terminated || outcome.truncated;
-    if (finished_flag_[i]) {
-      if (outcome.truncated) {
-        std::copy(observation, observation + observation_size_,
-                  final_observations_.data() +
-                      static_cast<size_t>(i) * observation_size_);
-      }
-      finished_stats_[i] = envs_[i]->episode();
-      envs_[i]->Reset(observation);
-    }
-  }
+  for (int i = 0; i < count; ++i) StepEnv(i);
   if (finished == nullptr) return;
   for (int i = 0; i < count; ++i) {
     if (finished_flag_[i]) finished->push_back({i, finished_stats_[i]});
+  }
+}
+
+void VecEnv::StepRange(int begin, int end,
+                       std::vector<FinishedEpisode>* finished) {
+  for (int i = begin; i < end; ++i) {
+    StepEnv(i);
+    if (finished != nullptr && finished_flag_[i])
+      finished->push_back({i, finished_stats_[i]});
+  }
+}
+
+void VecEnv::StepEnv(int i) {
+  float* observation =
+      observations_.data() + static_cast<size_t>(i) * observation_size_;
+  StepOutcome outcome = envs_[i]->Step(
+      actions_.data() + static_cast<size_t>(i) * action_size_, observation);
+  rewards_[i] = outcome.reward;
+  terminated_[i] = outcome.terminated;
+  truncated_[i] = outcome.truncated;
+  finished_flag_[i] = outcome.terminated || outcome.truncated;
+  if (finished_flag_[i]) {
+    if (outcome.truncated) {
+      std::copy(observation, observation + observation_size_,
+                final_observations_.data() +
+                    static_cast<size_t>(i) * observation_size_);
+    }
+    finished_stats_[i] = envs_[i]->episode();
+    envs_[i]->Reset(observation);
   }
 }
 

@@ -51,11 +51,19 @@ class VecEnv {
   // ended are reset, and observations() then holds their new first
   // observation. Finished episodes are appended to `finished` (if given).
   void Step(std::vector<FinishedEpisode>* finished = nullptr);
+  // Steps environments [begin, end) alone, on the calling thread, as Step()
+  // does (for callers that give each thread its own share of environments).
+  // Calls on disjoint ranges may run concurrently.
+  void StepRange(int begin, int end, std::vector<FinishedEpisode>* finished);
 
   TrackingEnv& env(int i) { return *envs_[i]; }
   int num_threads() const { return num_threads_; }
 
  private:
+  // Steps environment i, resets it if its episode ended (flags and stats
+  // kept for the caller's report).
+  void StepEnv(int i);
+
   std::vector<std::unique_ptr<TrackingEnv>> envs_;
   int observation_size_ = 0;
   int action_size_ = 0;

@@ -1,6 +1,8 @@
-// fit: the terms of the fit's objective as Ceres cost functors (templated,
-// for automatic differentiation). docs/fit.md writes each one out. Every
-// functor returns weighted residuals; Ceres minimizes half their squared sum.
+// fit: the terms of the fit's objective as Ceres cost functions. docs/fit.md
+// writes each one out. Every term returns weighted residuals; Ceres
+// minimizes half their squared sum. The per-frame terms that run the forward
+// kinematics (FrameCost, FootSlideCost) have analytic Jacobians (costs.cc);
+// the others are templated functors for automatic differentiation.
 #ifndef MIMIC2D_FIT_COSTS_H_
 #define MIMIC2D_FIT_COSTS_H_
 
@@ -50,54 +52,13 @@ struct FrameCost {
     return 2 * model.num_keypoints() + 1 + model.num_sole_points() + 2;
   }
 
-  template <typename T>
-  bool operator()(T const* const* blocks, T* residuals) const {
-    const int num_keypoints = model->num_keypoints();
-    const int num_soles = model->num_sole_points();
-    constexpr int kMaxPoints = 128;  // FromCharacter checks the count
-    T points[3 * kMaxPoints];
-    CharacterPoints(*model, blocks[3], blocks[4], blocks[5], points);
-    T* out = residuals;
-    for (int j = 0; j < num_keypoints; ++j, out += 2) {
-      if (weights[j] == 0.0) {
-        out[0] = out[1] = T(0);
-        continue;
-      }
-      T pixel[2];
-      FitProject(blocks[0][0], blocks[1], blocks[2], &points[3 * j], cx_px,
-                 cy_px, pixel);
-      for (int k = 0; k < 2; ++k) {
-        const T error = (pixel[k] - T(observed_px[j][k])) * T(inv_scale_px);
-        out[k] = T(weights[j]) * GemanMcClureResidual(error, sigma);
-      }
-    }
-    T lowest = points[3 * num_keypoints + 2];
-    for (int s = 0; s < num_soles; ++s) {
-      const T& z = points[3 * (num_keypoints + s) + 2];
-      if (z < lowest) lowest = z;
-      out[1 + s] = z < T(0) ? T(penetration_weight) * z : T(0);
-    }
-    out[0] = T(ground_weight) * GemanMcClureResidual(lowest, airborne_m);
-    out += 1 + num_soles;
-    // The root's up axis is the third column of its rotation.
-    const T* q = blocks[4];
-    const T norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    out[0] = T(upright_weight) * T(2) * (q[1] * q[3] + q[0] * q[2]) / norm2;
-    out[1] = T(upright_weight) * T(2) * (q[2] * q[3] - q[0] * q[1]) / norm2;
-    return true;
-  }
+  // Residuals and, for the blocks `jacobians` asks for, their derivatives:
+  // the pose's from CharacterPointsWithJacobian, the projection's through
+  // 9-wide Jets (camera and point).
+  bool Evaluate(double const* const* blocks, double* residuals,
+                double** jacobians) const;
 
-  static ceres::CostFunction* Create(FrameCost cost) {
-    const int num_hinges = cost.model->num_hinges();
-    const int num_residuals = NumResiduals(*cost.model);
-    auto* function = new ceres::DynamicAutoDiffCostFunction<FrameCost, 16>(
-        new FrameCost(std::move(cost)));
-    for (int size : {1, 2, 3, kRootPositionSize, kRootQuaternionSize})
-      function->AddParameterBlock(size);
-    function->AddParameterBlock(num_hinges);
-    function->SetNumResiduals(num_residuals);
-    return function;
-  }
+  static ceres::CostFunction* Create(FrameCost cost);
 };
 
 // One limb of one frame with everything else held (the limb search, stage
@@ -130,7 +91,7 @@ struct LimbCost {
 
   template <typename T>
   bool operator()(T const* const* blocks, T* residuals) const {
-    constexpr int kMaxPoints = 128, kMaxHinges = 128;
+    constexpr int kMaxHinges = 128;
     T hinges[kMaxHinges];
     for (size_t h = 0; h < hinges_rad.size(); ++h) hinges[h] = T(hinges_rad[h]);
     for (size_t i = 0; i < limb_hinges.size(); ++i)
@@ -138,7 +99,7 @@ struct LimbCost {
     const T root[3] = {T(root_m[0]), T(root_m[1]), T(root_m[2])};
     const T quaternion[4] = {T(quaternion_wxyz[0]), T(quaternion_wxyz[1]),
                              T(quaternion_wxyz[2]), T(quaternion_wxyz[3])};
-    T points[3 * kMaxPoints];
+    T points[3 * kMaxFitPoints];
     CharacterPoints(*model, root, quaternion, hinges, points);
     const T focal(focal_px);
     const T pitch_roll[2] = {T(pitch_roll_rad[0]), T(pitch_roll_rad[1])};
@@ -181,37 +142,12 @@ struct FootSlideCost {
   const KinematicModel* model;
   std::vector<double> contact_weights;  // per sole point
 
-  template <typename T>
-  bool operator()(T const* const* blocks, T* residuals) const {
-    const int num_keypoints = model->num_keypoints();
-    const int num_soles = model->num_sole_points();
-    constexpr int kMaxPoints = 128;  // FromCharacter checks the count
-    T before[3 * kMaxPoints], after[3 * kMaxPoints];
-    CharacterPoints(*model, blocks[0], blocks[1], blocks[2], before);
-    CharacterPoints(*model, blocks[3], blocks[4], blocks[5], after);
-    for (int s = 0; s < num_soles; ++s) {
-      const int at = 3 * (num_keypoints + s);
-      for (int k = 0; k < 2; ++k) {
-        residuals[2 * s + k] =
-            T(contact_weights[s]) * (after[at + k] - before[at + k]);
-      }
-    }
-    return true;
-  }
+  // Residuals and requested Jacobians (analytic, from
+  // CharacterPointsWithJacobian).
+  bool Evaluate(double const* const* blocks, double* residuals,
+                double** jacobians) const;
 
-  static ceres::CostFunction* Create(FootSlideCost cost) {
-    const int num_hinges = cost.model->num_hinges();
-    const int num_residuals = 2 * cost.model->num_sole_points();
-    auto* function = new ceres::DynamicAutoDiffCostFunction<FootSlideCost, 16>(
-        new FootSlideCost(std::move(cost)));
-    for (int frame = 0; frame < 2; ++frame) {
-      function->AddParameterBlock(kRootPositionSize);
-      function->AddParameterBlock(kRootQuaternionSize);
-      function->AddParameterBlock(num_hinges);
-    }
-    function->SetNumResiduals(num_residuals);
-    return function;
-  }
+  static ceres::CostFunction* Create(FootSlideCost cost);
 };
 
 // weight x (value - prior), element-wise over one block (pose prior: hinge

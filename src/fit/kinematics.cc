@@ -1,5 +1,7 @@
 #include "fit/kinematics.h"
 
+#include <ceres/jet.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 
@@ -39,12 +41,104 @@ std::vector<Eigen::Vector3d> SoleCorners(const mjModel* model, int body) {
 
 }  // namespace
 
+void CharacterPointsWithJacobian(const KinematicModel& model,
+                                 const double* root_position_m,
+                                 const double* root_quaternion_wxyz,
+                                 const double* hinges_rad, double* points_m,
+                                 double* jacobian) {
+  // Outline: the joint frames; each hinge's world axis (its sign folded in)
+  // and pivot; the rotation's derivatives in the quaternion (4-wide Jets
+  // through the same conversion the frames use); then per point its
+  // position and one Jacobian row block: identity for the root position,
+  // dR/dq u for the quaternion, axis x (point - pivot) for every hinge of
+  // the joints above it.
+  using Eigen::Matrix3d;
+  using Eigen::Vector3d;
+  Matrix3d orientation[kMaxFitJoints];
+  Vector3d position[kMaxFitJoints];
+  JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
+              orientation, position);
+  const int num_joints = static_cast<int>(model.joints.size());
+  const int num_hinges = model.num_hinges();
+  std::vector<Vector3d> hinge_axis(num_hinges);
+  for (int j = 0; j < num_joints; ++j) {
+    const KinematicModel::Joint& joint = model.joints[j];
+    const Matrix3d parent =
+        joint.parent < 0 ? Matrix3d::Identity() : orientation[joint.parent];
+    if (joint.type == JointType::kSpherical) {
+      // Rx(a) Ry(b) Rz(c): each axis as the preceding rotations leave it.
+      const double* angles = hinges_rad + joint.first_hinge;
+      const Matrix3d rx =
+          fk_internal::AxisRotation<double>(Vector3d::UnitX(), angles[0]);
+      const Matrix3d ry =
+          fk_internal::AxisRotation<double>(Vector3d::UnitY(), angles[1]);
+      hinge_axis[joint.first_hinge] = parent.col(0);
+      hinge_axis[joint.first_hinge + 1] = parent * rx.col(1);
+      hinge_axis[joint.first_hinge + 2] = parent * (rx * ry).col(2);
+    } else if (joint.type == JointType::kRevolute) {
+      hinge_axis[joint.first_hinge] =
+          joint.revolute_sign * (parent * joint.axis);
+    }
+  }
+  // dR/dq_k, and which joint carries the quaternion.
+  using Jet4 = ceres::Jet<double, 4>;
+  Jet4 quaternion[4], rotation[9];
+  for (int k = 0; k < 4; ++k) quaternion[k] = Jet4(root_quaternion_wxyz[k], k);
+  ceres::QuaternionToRotation(quaternion, rotation);
+  int free_joint = -1;
+  for (int j = 0; j < num_joints; ++j) {
+    if (model.joints[j].type == JointType::kFree) free_joint = j;
+  }
+
+  const int columns = PoseJacobianColumns(model);
+  constexpr int kFirstHingeColumn = kRootPositionSize + kRootQuaternionSize;
+  int row = 0;
+  for (const std::vector<BodyPoint>* points :
+       {&model.keypoints, &model.sole_points}) {
+    for (const BodyPoint& point : *points) {
+      const Vector3d world =
+          position[point.joint] + orientation[point.joint] * point.offset_m;
+      for (int c = 0; c < 3; ++c) points_m[row + c] = world[c];
+      double* rows[3] = {jacobian + row * columns,
+                         jacobian + (row + 1) * columns,
+                         jacobian + (row + 2) * columns};
+      for (double* r : rows) std::fill(r, r + columns, 0.0);
+      for (int c = 0; c < 3; ++c) rows[c][c] = 1.0;
+      if (free_joint >= 0) {
+        const Vector3d in_root = orientation[free_joint].transpose() *
+                                 (world - position[free_joint]);
+        for (int c = 0; c < 3; ++c)
+          for (int k = 0; k < 4; ++k) {
+            rows[c][kRootPositionSize + k] =
+                rotation[3 * c].v[k] * in_root[0] +
+                rotation[3 * c + 1].v[k] * in_root[1] +
+                rotation[3 * c + 2].v[k] * in_root[2];
+          }
+      }
+      for (int j = point.joint; j >= 0; j = model.joints[j].parent) {
+        const KinematicModel::Joint& joint = model.joints[j];
+        const int dofs = joint.type == JointType::kSpherical  ? 3
+                         : joint.type == JointType::kRevolute ? 1
+                                                              : 0;
+        const Vector3d lever = world - position[j];
+        for (int d = 0; d < dofs; ++d) {
+          const int hinge = joint.first_hinge + d;
+          const Vector3d moved = hinge_axis[hinge].cross(lever);
+          for (int c = 0; c < 3; ++c)
+            rows[c][kFirstHingeColumn + hinge] = moved[c];
+        }
+      }
+      row += 3;
+    }
+  }
+}
+
 KinematicModel KinematicModel::FromCharacter(const Character& character) {
   const Skeleton& skeleton = character.skeleton();
   const mjModel* mj_model = character.model();
   KinematicModel model;
   model.skeleton_name = skeleton.name;
-  if (skeleton.num_joints() > 64) {
+  if (skeleton.num_joints() > kMaxFitJoints) {
     throw InputError(character.config().source_path,
                      "the fit handles skeletons of up to 64 joints");
   }
@@ -81,7 +175,7 @@ KinematicModel KinematicModel::FromCharacter(const Character& character) {
     }
     if (!corners.empty()) ++model.num_feet;
   }
-  if (model.num_keypoints() + model.num_sole_points() > 128) {
+  if (model.num_keypoints() + model.num_sole_points() > kMaxFitPoints) {
     throw InputError(character.config().source_path,
                      "the fit handles up to 128 keypoints and sole points");
   }

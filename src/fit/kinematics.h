@@ -111,21 +111,21 @@ Matrix3<T> IntrinsicXyzRotation(const T* angles) {
 
 }  // namespace fk_internal
 
-// World positions of the model's keypoints then its sole points, 3 numbers
-// each, into `points_m` (size 3 x (keypoints + sole points)).
+inline constexpr int kMaxFitJoints = 64;   // FromCharacter checks the count
+inline constexpr int kMaxFitPoints = 128;  // keypoints + sole points, checked
+
+// Every joint's world frame (orientation and origin), parents before
+// children: the forward kinematics that CharacterPoints and
+// CharacterPointsWithJacobian share.
 template <typename T>
-void CharacterPoints(const KinematicModel& model, const T* root_position_m,
-                     const T* root_quaternion_wxyz, const T* hinges_rad,
-                     T* points_m) {
+void JointFrames(const KinematicModel& model, const T* root_position_m,
+                 const T* root_quaternion_wxyz, const T* hinges_rad,
+                 fk_internal::Matrix3<T>* orientation,
+                 fk_internal::Vector3<T>* position) {
   using fk_internal::AxisRotation;
   using Matrix3 = fk_internal::Matrix3<T>;
   using Vector3 = fk_internal::Vector3<T>;
-  // Outline: compose each joint's world frame from its parent's (parents
-  // come first), then place the body points in their joints' frames.
   const int num_joints = static_cast<int>(model.joints.size());
-  constexpr int kMaxJoints = 64;  // FromCharacter checks the count
-  Matrix3 orientation[kMaxJoints];
-  Vector3 position[kMaxJoints];
   for (int j = 0; j < num_joints; ++j) {
     const KinematicModel::Joint& joint = model.joints[j];
     Matrix3 local = Matrix3::Identity();
@@ -151,6 +151,21 @@ void CharacterPoints(const KinematicModel& model, const T* root_position_m,
       orientation[j] = orientation[joint.parent] * local;
     }
   }
+}
+
+// World positions of the model's keypoints then its sole points, 3 numbers
+// each, into `points_m` (size 3 x (keypoints + sole points)).
+template <typename T>
+void CharacterPoints(const KinematicModel& model, const T* root_position_m,
+                     const T* root_quaternion_wxyz, const T* hinges_rad,
+                     T* points_m) {
+  using Vector3 = fk_internal::Vector3<T>;
+  // Outline: compose each joint's world frame from its parent's, then place
+  // the body points in their joints' frames.
+  fk_internal::Matrix3<T> orientation[kMaxFitJoints];
+  Vector3 position[kMaxFitJoints];
+  JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
+              orientation, position);
   int out = 0;
   for (const std::vector<BodyPoint>* points :
        {&model.keypoints, &model.sole_points}) {
@@ -161,6 +176,25 @@ void CharacterPoints(const KinematicModel& model, const T* root_position_m,
     }
   }
 }
+
+// Columns of a pose Jacobian: root position (3), root quaternion (4, as
+// given: CharacterPoints normalizes it), hinge angles.
+inline int PoseJacobianColumns(const KinematicModel& model) {
+  return kRootPositionSize + kRootQuaternionSize + model.num_hinges();
+}
+
+// CharacterPoints in doubles, with the points' derivatives with respect to
+// the pose in `jacobian` (row-major: 3 x points rows, PoseJacobianColumns
+// columns). Analytic: a hinge moves a point by its world axis x the lever
+// arm from its joint; the quaternion's columns are dR/dq applied to the
+// point in the root frame. The fit's per-frame costs use it instead of
+// automatic differentiation, which spent most of a fit's time pushing
+// 16-wide Jets through these same products (docs/fit.md, "Speed").
+void CharacterPointsWithJacobian(const KinematicModel& model,
+                                 const double* root_position_m,
+                                 const double* root_quaternion_wxyz,
+                                 const double* hinges_rad, double* points_m,
+                                 double* jacobian);
 
 // A limb: a chain of joints hanging off the trunk (an arm, a leg, the
 // head), the hinges that move its keypoints, and those keypoints. Its

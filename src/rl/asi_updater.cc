@@ -22,48 +22,104 @@ AsiUpdater::AsiUpdater(std::shared_ptr<const Character> character,
 }
 
 void AsiUpdater::BeginRollout() {
-  captured_.clear();
-  captured_observations_.clear();
+  captured_.states.clear();
+  captured_.observations.clear();
 }
 
 void AsiUpdater::Capture(VecEnv& envs, int step) {
+  CaptureRange(envs, step, 0, envs.num_envs(), &captured_);
+}
+
+void AsiUpdater::CaptureRange(VecEnv& envs, int step, int begin, int end,
+                              Captures* into) const {
   if (step % options_.capture_every_steps != 0) return;
   const int observation_size = envs.observation_size();
-  for (int i = 0; i < envs.num_envs(); ++i) {
+  for (int i = begin; i < end; ++i) {
     if (envs.terminated()[i] || envs.truncated()[i]) continue;
     TrackingEnv& env = envs.env(i);
-    captured_.push_back({initial_states_->BufferOf(env.episode().view_index),
-                         env.frame(), env.simulation().Save()});
+    into->states.push_back({initial_states_->BufferOf(env.episode().view_index),
+                            env.episode().view_index, env.frame(),
+                            env.simulation().Save()});
     const float* row =
         envs.observations() + static_cast<size_t>(i) * observation_size;
-    captured_observations_.insert(captured_observations_.end(), row,
-                                  row + observation_size);
+    into->observations.insert(into->observations.end(), row,
+                              row + observation_size);
   }
+}
+
+void AsiUpdater::Add(const Captures& captures) {
+  captured_.states.insert(captured_.states.end(), captures.states.begin(),
+                          captures.states.end());
+  captured_.observations.insert(captured_.observations.end(),
+                                captures.observations.begin(),
+                                captures.observations.end());
 }
 
 void AsiUpdater::Update(const Critic& critic, int iteration) {
   torch::NoGradGuard no_grad;
-  if (!captured_.empty()) {
+  const std::vector<CapturedState>& states = captured_.states;
+  if (!states.empty()) {
     const int64_t observation_size =
-        static_cast<int64_t>(captured_observations_.size() / captured_.size());
+        static_cast<int64_t>(captured_.observations.size() / states.size());
     torch::Tensor raw = torch::from_blob(
-        captured_observations_.data(),
-        {static_cast<int64_t>(captured_.size()), observation_size});
+        captured_.observations.data(),
+        {static_cast<int64_t>(states.size()), observation_size});
     torch::Tensor scores = critic(raw).to(torch::kDouble).contiguous();
     const double* score = scores.data_ptr<double>();
-    for (size_t i = 0; i < captured_.size(); ++i) {
-      initial_states_->buffer(captured_[i].buffer)
-          .Insert(captured_[i].frame, captured_[i].state, score[i]);
+    for (size_t i = 0; i < states.size(); ++i) {
+      StateBuffer& buffer = initial_states_->buffer(states[i].buffer);
+      if (!buffer.Insert(states[i].frame, states[i].state, score[i])) continue;
+      // Keep what the capture observed, for rescoring.
+      const int frame = states[i].frame;
+      for (int e = 0; e < buffer.size(frame); ++e) {
+        if (!SameObservedState(buffer.entry(frame, e).state, states[i].state))
+          continue;
+        ObservedEntry& observed = ObservedAt(states[i].buffer, frame, e);
+        observed.view = states[i].view;
+        KeepObservedState(states[i].state, &observed);
+        const float* row = captured_.observations.data() + i * observation_size;
+        observed.raw.assign(row, row + observation_size);
+        break;
+      }
     }
   }
-  constexpr int kRescoreEveryIterations = 10;
-  if (iteration % kRescoreEveryIterations == 0) RescoreAll(critic);
+  if (iteration % options_.rescore_every_iterations == 0) RescoreAll(critic);
+}
+
+AsiUpdater::ObservedEntry& AsiUpdater::ObservedAt(int buffer, int frame,
+                                                  int entry) {
+  if (observed_.size() <= static_cast<size_t>(buffer))
+    observed_.resize(initial_states_->num_buffers());
+  auto& frames = observed_[buffer];
+  if (frames.size() <= static_cast<size_t>(frame))
+    frames.resize(initial_states_->buffer(buffer).num_frames());
+  auto& entries = frames[frame];
+  if (entries.size() <= static_cast<size_t>(entry))
+    entries.resize(
+        initial_states_->buffer(buffer).options().capacity_per_frame);
+  return entries[entry];
+}
+
+void AsiUpdater::KeepObservedState(const SimState& state,
+                                   ObservedEntry* observed) {
+  observed->qpos = state.qpos;
+  observed->qvel = state.qvel;
+}
+
+bool AsiUpdater::SameObservedState(const SimState& state,
+                                   const ObservedEntry& observed) {
+  return state.qpos == observed.qpos && state.qvel == observed.qvel;
+}
+
+bool AsiUpdater::SameObservedState(const SimState& a, const SimState& b) {
+  return a.qpos == b.qpos && a.qvel == b.qvel;
 }
 
 void AsiUpdater::RescoreAll(const Critic& critic) {
   // Outline: list every kept entry with the view it is seen from (drawn in
-  // order, so runs are reproducible for any thread count), observe them in
-  // parallel, score them in one critic batch, write the scores back.
+  // order, so runs are reproducible for any thread count), observe in
+  // parallel those not observed so from that view before, score them all
+  // in one critic batch, write the scores back.
   struct Slot {
     int buffer, frame, entry, view;
   };
@@ -89,16 +145,27 @@ void AsiUpdater::RescoreAll(const Critic& critic) {
 
   const int observation_size = scoring_envs_[0]->observation_size();
   std::vector<float> batch(slots.size() * observation_size);
+  // Sized here, so that the parallel loop only writes its own entries.
+  for (const Slot& slot : slots)
+    ObservedAt(slot.buffer, slot.frame, slot.entry);
   const int num_threads = static_cast<int>(scoring_envs_.size());
-#pragma omp parallel for schedule(static) num_threads(num_threads)
+#pragma omp parallel for schedule(dynamic, 64) num_threads(num_threads)
   for (size_t k = 0; k < slots.size(); ++k) {
     const Slot& slot = slots[k];
-    scoring_envs_[omp_get_thread_num()]->ResetTo(
-        slot.view, slot.frame,
-        initial_states_->buffer(slot.buffer)
-            .entry(slot.frame, slot.entry)
-            .state,
-        batch.data() + k * observation_size);
+    const SimState& state = initial_states_->buffer(slot.buffer)
+                                .entry(slot.frame, slot.entry)
+                                .state;
+    ObservedEntry& observed = observed_[slot.buffer][slot.frame][slot.entry];
+    float* row = batch.data() + k * observation_size;
+    if (observed.view == slot.view && SameObservedState(state, observed)) {
+      std::copy(observed.raw.begin(), observed.raw.end(), row);
+      continue;
+    }
+    scoring_envs_[omp_get_thread_num()]->ResetTo(slot.view, slot.frame, state,
+                                                 row);
+    observed.view = slot.view;
+    KeepObservedState(state, &observed);
+    observed.raw.assign(row, row + observation_size);
   }
 
   torch::Tensor raw = torch::from_blob(

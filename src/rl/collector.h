@@ -11,13 +11,12 @@
 #include <vector>
 
 #include "env/vec_env.h"
+#include "rl/asi_updater.h"
 #include "rl/networks.h"
 #include "rl/ppo.h"
 #include "rl/train_config.h"
 
 namespace m2d {
-
-class AsiUpdater;
 
 class RolloutCollector {
  public:
@@ -29,13 +28,39 @@ class RolloutCollector {
   // Fills `storage` acting with `policy` (whose observation normalizer is
   // updated when options.normalize_observations); `asi` (may be null)
   // captures visited states; episodes that end are appended to `finished`.
+  // options.collection chooses how the env threads are used.
   void Collect(ActorCritic& policy, AsiUpdater* asi, RolloutStorage& storage,
                std::vector<FinishedEpisode>* finished);
 
  private:
+  // One thread's share of the environments under kPerThread.
+  struct Shard {
+    int begin = 0, end = 0;  // environments [begin, end)
+    torch::Generator generator;
+  };
+  void CollectBatched(ActorCritic& policy, AsiUpdater* asi,
+                      RolloutStorage& storage,
+                      std::vector<FinishedEpisode>* finished);
+  void CollectPerThread(ActorCritic& policy, AsiUpdater* asi,
+                        RolloutStorage& storage,
+                        std::vector<FinishedEpisode>* finished);
+  void CollectShard(ActorCritic& policy, AsiUpdater* asi, Shard& shard,
+                    RolloutStorage& storage, torch::Tensor& last_values,
+                    std::vector<FinishedEpisode>* finished,
+                    AsiUpdater::Captures* captures);
+  // After a step of environments [begin, end): their rewards (time-limit
+  // truncations bootstrapped with the critic) and done flags into this
+  // step's rows of the storage.
+  void RecordStepOutcome(ActorCritic& policy, int begin, int end,
+                         torch::Tensor rewards, torch::Tensor dones);
+
   VecEnv& envs_;
   PpoOptions options_;
-  torch::Generator generator_;
+  torch::Generator generator_;                      // kBatched's action noise
+  std::vector<torch::Generator> shard_generators_;  // kPerThread's, per thread
+  // kPerThread: every step's raw observations, for the normalizer after
+  // the rollout. [steps, num_envs, observation_size].
+  torch::Tensor raw_observations_ = torch::empty({0, 0, 0});
 };
 
 // Copies `from`'s parameters (and, with `buffers`, its buffers: the

@@ -24,6 +24,7 @@ struct Setting {
   std::string label;
   int torch_threads = 1;
   TrainingPrecision precision = TrainingPrecision::kFp32;
+  CollectionMode collection = CollectionMode::kBatched;
   bool overlap = false;
 };
 
@@ -35,6 +36,7 @@ TrainTiming MeasureTraining(TrainConfig config, const Setting& setting,
   config.run.run_dir = scratch;
   config.ppo.torch_threads = setting.torch_threads;
   config.ppo.training_precision = setting.precision;
+  config.ppo.collection = setting.collection;
   config.ppo.overlap_update = setting.overlap;
   // Each setting is measured as given: the config's thread tuner would
   // switch counts mid-measurement (and rejects 1 thread as its maximum).
@@ -123,28 +125,34 @@ void RunTrainBenchmark(const TrainBenchmarkOptions& options) {
       bound, config.ppo.num_envs, config.run.env_threads);
   std::vector<TrainingPrecision> precisions = options.precisions;
   if (precisions.empty()) precisions = {config.ppo.training_precision};
+  std::vector<CollectionMode> collections = options.collections;
+  if (collections.empty()) collections = {config.ppo.collection};
   std::vector<Setting> settings;
   for (int threads : options.torch_threads) {
     for (TrainingPrecision precision : precisions) {
-      settings.push_back(
-          {std::to_string(threads) + " " + SettingName(precision), threads,
-           precision, false});
+      for (CollectionMode collection : collections) {
+        settings.push_back({std::to_string(threads) + " " +
+                                SettingName(precision) + " " +
+                                SettingName(collection),
+                            threads, precision, collection, false});
+      }
     }
   }
   if (options.overlap) {
-    settings.push_back(
-        {std::string("overlap 1+1 ") + SettingName(precisions.back()), 1,
-         precisions.back(), true});
+    settings.push_back({std::string("overlap 1+1 ") +
+                            SettingName(precisions.back()) + " batched",
+                        1, precisions.back(), CollectionMode::kBatched, true});
   }
-  std::printf("%-18s %10s %9s %9s %9s %9s %9s\n", "threads precision",
-              "samples/s", "collect", "update", "asi", "ratio", "of bound");
+  std::printf("%-27s %10s %9s %9s %9s %9s %9s\n",
+              "threads precision collection", "samples/s", "collect", "update",
+              "asi", "ratio", "of bound");
   double baseline = 0.0;
   for (const Setting& setting : settings) {
     const TrainTiming timing = MeasureTraining(config, setting, options);
     if (baseline == 0.0) baseline = timing.samples_per_s();
     // Shares of the wall time; with overlap collect + update exceed 100 %.
     const double wall = timing.wall_s;
-    std::printf("%-18s %10.0f %8.0f%% %8.0f%% %8.0f%% %9.2f %9.2f\n",
+    std::printf("%-27s %10.0f %8.0f%% %8.0f%% %8.0f%% %9.2f %9.2f\n",
                 setting.label.c_str(), timing.samples_per_s(),
                 100 * timing.collect_s / wall, 100 * timing.update_s / wall,
                 100 * timing.asi_s / wall, timing.samples_per_s() / baseline,

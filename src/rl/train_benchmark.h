@@ -1,10 +1,10 @@
 // rl: `mimic2d bench train` — end-to-end training throughput of a config
 // (simulation + policy inference + PPO update + ASI) for several LibTorch
-// thread counts and arithmetic precisions and with the update overlapped
-// with collection, against
-// the simulation-only bound measured in the same run: the config's own
-// environments stepped with Gaussian actions and no policy, on the
-// config's env threads (docs/benchmarks.md). No LibTorch in this header.
+// thread counts, arithmetic precisions and collection modes and with the
+// update overlapped with collection, against the simulation-only bound measured
+// in the same run: the config's own environments stepped with Gaussian actions
+// and no policy, on the config's env threads (docs/benchmarks.md). No LibTorch
+// in this header.
 #ifndef MIMIC2D_RL_TRAIN_BENCHMARK_H_
 #define MIMIC2D_RL_TRAIN_BENCHMARK_H_
 
@@ -24,6 +24,9 @@ struct TrainBenchmarkOptions {
   // Each thread count is measured at each of these (empty: the config's
   // agent.training_precision); the overlapped row uses the last.
   std::vector<TrainingPrecision> precisions;
+  // ... and at each of these collection modes (empty: the config's
+  // agent.collection); the overlapped row collects batched.
+  std::vector<CollectionMode> collections;
   bool overlap = true;    // also measure agent.overlap_update
   int bound_steps = 200;  // control steps of the simulation-only bound
   // Throws ConfigError naming the bad option.

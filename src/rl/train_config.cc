@@ -2,6 +2,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
+#include "common/settings.h"
 #include "common/yaml_fields.h"
 
 namespace m2d {
@@ -33,14 +34,17 @@ const char* SettingName(TrainingPrecision precision) {
 }
 
 bool ParseSetting(const std::string& text, TrainingPrecision* precision) {
-  for (TrainingPrecision known :
-       {TrainingPrecision::kFp32, TrainingPrecision::kBf16}) {
-    if (text == SettingName(known)) {
-      *precision = known;
-      return true;
-    }
-  }
-  return false;
+  return ParseSettingByName(
+      text, {TrainingPrecision::kFp32, TrainingPrecision::kBf16}, precision);
+}
+
+const char* SettingName(CollectionMode mode) {
+  return mode == CollectionMode::kPerThread ? "per_thread" : "batched";
+}
+
+bool ParseSetting(const std::string& text, CollectionMode* mode) {
+  return ParseSettingByName(
+      text, {CollectionMode::kBatched, CollectionMode::kPerThread}, mode);
 }
 
 void ModelOptions::Validate() const {
@@ -74,6 +78,11 @@ void PpoOptions::Validate() const {
         "agent.overlap_update and agent.adapt_torch_threads exclude each "
         "other (with overlap, collection and update each run on one "
         "LibTorch thread)");
+  }
+  if (overlap_update && collection == CollectionMode::kPerThread) {
+    throw ConfigError(
+        "agent.overlap_update and agent.collection: per_thread exclude each "
+        "other (overlap collects on one thread)");
   }
 }
 

@@ -86,6 +86,24 @@ const char* SettingName(TrainingPrecision precision);
 bool ParseSetting(const std::string& text, TrainingPrecision* precision);
 inline std::string SettingChoices(TrainingPrecision) { return "fp32, bf16"; }
 
+// How collection shares the env threads between acting and simulating.
+enum class CollectionMode {
+  // Per step: one batched forward pass for every environment, then every
+  // environment's physics on the env threads. The network's serial parts
+  // leave the other cores waiting at each step.
+  kBatched,
+  // Each env thread acts for its own share of the environments (forward
+  // passes of its rows, on one LibTorch thread) and steps them, with no
+  // barrier between steps. The observation normalizer's statistics stay
+  // fixed during a rollout and take in its observations after it.
+  kPerThread,
+};
+const char* SettingName(CollectionMode mode);
+bool ParseSetting(const std::string& text, CollectionMode* mode);
+inline std::string SettingChoices(CollectionMode) {
+  return "batched, per_thread";
+}
+
 // PPO (CleanRL-style "agent" config). Every field is documented in
 // configs/README.md with the reasoning behind its default.
 struct PpoOptions {
@@ -120,6 +138,7 @@ struct PpoOptions {
   // stored log-probabilities allows (docs/training.md, "Throughput").
   bool overlap_update = false;
   TrainingPrecision training_precision = TrainingPrecision::kFp32;
+  CollectionMode collection = CollectionMode::kBatched;
 
   // Every setting (common/settings.h): the config's `agent` section.
   template <typename Self, typename Visitor>
@@ -166,6 +185,10 @@ struct PpoOptions {
     v("training_precision", self.training_precision, Range::Any(),
       "arithmetic of the networks' matrix products in collection and "
       "update: fp32, or bf16 (float32 weights and losses)");
+    v("collection", self.collection, Range::Any(),
+      "batched: one forward pass for all environments per step, then their "
+      "physics on the env threads; per_thread: each env thread acts for and "
+      "steps its own share, with no barrier between steps");
   }
   int batch_size() const { return num_envs * steps_per_env; }
   void Validate() const;
@@ -174,7 +197,10 @@ struct PpoOptions {
 // Adaptive State Initialization.
 struct AsiOptions {
   bool enabled = true;
-  int capture_every_steps = 4;        // visited states offered to the buffers
+  int capture_every_steps = 4;  // visited states offered to the buffers
+  // Every kept entry is rescored by the critic this often (the critic
+  // moves; an entry's stored score ages).
+  int rescore_every_iterations = 10;
   StateBufferOptions buffer{4, 2.0};  // per frame: 4 states, T = 2 (of V)
 
   // Every setting (common/settings.h): the config's `asi` section.
@@ -184,6 +210,10 @@ struct AsiOptions {
       "Adaptive State Initialization on/off");
     v("capture_every_steps", self.capture_every_steps, Range::AtLeast(1),
       "visited states are offered to the buffers every this many steps");
+    v("rescore_every_iterations", self.rescore_every_iterations,
+      Range::AtLeast(1),
+      "every kept entry is rescored by the critic every this many "
+      "iterations");
     decltype(self.buffer)::VisitFields(self.buffer, v);
   }
   void Validate() const;

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <thread>
 
 #include "common/error.h"
 #include "env/vec_env.h"
@@ -141,26 +144,78 @@ TEST(VecEnv, ZeroAndRandomActionRolloutsStayFinite) {
   }
 }
 
-// Environment i is seeded seed + i, so one or two threads give the same run.
-TEST(VecEnv, ResultsDoNotDependOnTheThreadCount) {
+// Environment i is seeded seed + i, so one or two threads give the same run,
+// and so do two threads each stepping its own share (StepRange, as the
+// per-thread collector does).
+TEST(VecEnv, ResultsDoNotDependOnTheThreadCountOrTheShares) {
   M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
   std::vector<std::vector<float>> runs;
-  for (int threads : {1, 2}) {
+  for (int threads : {1, 2, 0}) {  // 0: two shares on two std::threads
     VecEnv envs(task.character, task.reference, task.initial_states,
-                task.options, 6, 3, threads);
+                task.options, 6, 3, std::max(threads, 1));
     envs.Reset();
+    std::vector<FinishedEpisode> finished, first_share, second_share;
     for (int step = 0; step < 60; ++step) {
       for (int i = 0; i < envs.num_envs() * envs.action_size(); ++i) {
         envs.actions()[i] = 0.3f * std::sin(0.1f * (i + step));
       }
-      envs.Step();
+      if (threads > 0) {
+        envs.Step(&finished);
+      } else {
+        std::thread first([&] { envs.StepRange(0, 2, &first_share); });
+        envs.StepRange(2, 6, &second_share);
+        first.join();
+      }
     }
-    runs.emplace_back(
+    if (threads == 0) {
+      finished = first_share;
+      finished.insert(finished.end(), second_share.begin(), second_share.end());
+    }
+    std::vector<float> run(
         envs.observations(),
         envs.observations() + envs.num_envs() * envs.observation_size());
+    for (const FinishedEpisode& episode : finished) {
+      run.push_back(static_cast<float>(episode.env));
+      run.push_back(static_cast<float>(episode.stats.steps));
+    }
+    runs.push_back(run);
   }
   EXPECT_EQ(runs[0], runs[1]);
+  // The shares report their episodes in share order, not step order.
+  std::sort(runs[0].begin(), runs[0].end());
+  std::sort(runs[2].begin(), runs[2].end());
+  EXPECT_EQ(runs[0], runs[2]);
+}
+
+// ASI keeps the observation a state was captured with and scores it again
+// later instead of restoring it: the two must be the same observation.
+TEST(TrackingEnv, AStateRestoredIsObservedAsItWasAfterItsStep) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  TrackingEnv stepped(task.character, task.reference, task.initial_states,
+                      task.options, 4);
+  TrackingEnv restored(task.character, task.reference, task.initial_states,
+                       task.options, 5);
+  std::vector<float> observation(stepped.observation_size()),
+      observed_again(stepped.observation_size()), action(stepped.action_size());
+  const int view = 1;
+  stepped.ResetTo(view, 3, task.initial_states->buffer(0).entry(3, 0).state,
+                  observation.data());
+  int steps = 0;
+  for (; steps < 12; ++steps) {
+    for (size_t i = 0; i < action.size(); ++i)
+      action[i] = 0.05f * std::sin(0.7f * i + steps);
+    StepOutcome outcome = stepped.Step(action.data(), observation.data());
+    if (outcome.terminated || outcome.truncated) break;
+    restored.ResetTo(view, stepped.frame(), stepped.simulation().Save(),
+                     observed_again.data());
+    for (size_t i = 0; i < observation.size(); ++i) {
+      ASSERT_NEAR(observed_again[i], observation[i], 1e-5)
+          << "step " << steps << ", element " << i;
+    }
+  }
+  EXPECT_GE(steps, 6);
 }
 
 TEST(TrackingEnv, BundleAtTheWrongRateIsRejected) {

@@ -118,6 +118,45 @@ TEST(FitKinematics, MatchesMujocoKeypointsAndSoles) {
   EXPECT_NEAR(model.standing_root_height_m, 0.881416, 1e-6);
 }
 
+// The analytic pose Jacobian the per-frame costs use equals automatic
+// differentiation of the templated kinematics (exactly, up to rounding),
+// for random poses and an unnormalized quaternion.
+TEST(FitKinematics, AnalyticPoseJacobianMatchesAutomaticDifferentiation) {
+  auto character = Humanoid();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  constexpr int kColumns = 35;  // root 3 + quaternion 4 + 28 hinges
+  ASSERT_EQ(PoseJacobianColumns(model), kColumns);
+  using Jet = ceres::Jet<double, kColumns>;
+  const int num_points = model.num_keypoints() + model.num_sole_points();
+  std::mt19937_64 rng(17);
+  for (int trial = 0; trial < 5; ++trial) {
+    RandomPose pose = MakeRandomPose(model, rng);
+    pose.quaternion_wxyz *= 0.7 + 0.2 * trial;  // any norm
+    std::vector<double> pose_vector(pose.root_m.data(), pose.root_m.data() + 3);
+    pose_vector.insert(pose_vector.end(), pose.quaternion_wxyz.data(),
+                       pose.quaternion_wxyz.data() + 4);
+    pose_vector.insert(pose_vector.end(), pose.hinges_rad.begin(),
+                       pose.hinges_rad.end());
+    std::vector<Jet> jets(kColumns);
+    for (int k = 0; k < kColumns; ++k) jets[k] = Jet(pose_vector[k], k);
+    std::vector<Jet> automatic(3 * num_points);
+    CharacterPoints(model, &jets[0], &jets[3], &jets[7], automatic.data());
+    std::vector<double> points(3 * num_points),
+        analytic(3 * num_points * kColumns);
+    CharacterPointsWithJacobian(
+        model, pose.root_m.data(), pose.quaternion_wxyz.data(),
+        pose.hinges_rad.data(), points.data(), analytic.data());
+    for (int row = 0; row < 3 * num_points; ++row) {
+      EXPECT_NEAR(points[row], automatic[row].a, 1e-12);
+      for (int k = 0; k < kColumns; ++k) {
+        ASSERT_NEAR(analytic[row * kColumns + k], automatic[row].v[k], 1e-9)
+            << "trial " << trial << ", point coordinate " << row << ", column "
+            << k;
+      }
+    }
+  }
+}
+
 TEST(FitCamera, PitchAndRollRoundTripThroughAPinholeCamera) {
   const double pitch_roll[2] = {0.3, -0.1};
   const double centre[3] = {1, 2, 1.5};

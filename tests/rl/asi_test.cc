@@ -4,6 +4,8 @@
 // the buffers stay as filled.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -14,6 +16,7 @@
 #include "env/reward.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
+#include "rl/asi_updater.h"
 #include "rl/checkpoint.h"
 #include "rl/trainer.h"
 #include "sim/simulation.h"
@@ -137,6 +140,64 @@ TEST(Asi, WithoutAsiTheNoisyBuffersStayAsFilled) {
   EXPECT_GT(errors.as_filled_px, 20.0);
   EXPECT_EQ(errors.trained_px, errors.as_filled_px);
   fs::remove_all(dir);
+}
+
+// Rescoring reuses the observation each entry was captured or last scored
+// with, as long as the entry holds the same state: every score must be the
+// critic's value of the entry's own observation from a view its buffer
+// serves, also after captures replaced entries. The critic here is the sum
+// of the raw observation, so a score names the observation it came from.
+TEST(Asi, RescoringScoresEveryEntrysOwnObservation) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(walk_path, 2.0);
+  AsiOptions options;
+  options.capture_every_steps = 1;
+  options.rescore_every_iterations = 2;
+  AsiUpdater asi(task.character, task.reference, task.initial_states,
+                 task.options, options, 3, 2);
+  VecEnv envs(task.character, task.reference, task.initial_states, task.options,
+              6, 3, 2);
+  envs.Reset();
+  const AsiUpdater::Critic critic = [](const torch::Tensor& raw) {
+    return raw.to(torch::kDouble).sum(1);
+  };
+  int64_t step = 0;
+  for (int iteration = 1; iteration <= 6; ++iteration) {
+    asi.BeginRollout();
+    for (int t = 0; t < 8; ++t, ++step) {
+      for (int i = 0; i < envs.num_envs() * envs.action_size(); ++i)
+        envs.actions()[i] = 0.3f * std::sin(0.1f * i + 0.3f * step);
+      envs.Step();
+      asi.Capture(envs, t);
+    }
+    asi.Update(critic, iteration);
+  }
+
+  // Every entry against its observations from each view of its buffer.
+  const InitialStates& states = *task.initial_states;
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 0);
+  std::vector<float> observation(env.observation_size());
+  const int num_views = static_cast<int>(task.reference->views().size());
+  int checked = 0;
+  for (int b = 0; b < states.num_buffers(); ++b) {
+    const StateBuffer& buffer = states.buffer(b);
+    for (int f = 0; f < buffer.num_frames(); ++f) {
+      for (int e = 0; e < buffer.size(f); ++e) {
+        double closest = 1e300;
+        for (int v = 0; v < num_views; ++v) {
+          if (states.BufferOf(v) != b) continue;
+          env.ResetTo(v, f, buffer.entry(f, e).state, observation.data());
+          double sum = 0.0;
+          for (float x : observation) sum += x;
+          closest = std::min(closest, std::abs(sum - buffer.entry(f, e).score));
+        }
+        EXPECT_LT(closest, 1e-3) << "buffer " << b << " frame " << f;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 60);
 }
 
 }  // namespace

@@ -1,0 +1,27 @@
+# Succ of every evaluated checkpoint (eval_curves.csv: 10 episodes x 10 s per
+# view from the fit's starts) against samples and against training wall
+# time, one line per variant. From the repository root:
+#   gnuplot docs/experiments/walk2d_fast/plot_eval_curves.gp
+set terminal pngcairo size 1400,520 font ",11" noenhanced
+set output "docs/images/samples_to_learn_eval.png"
+set datafile separator ","
+set key bottom right
+set grid
+set yrange [0:1]
+set ytics 0.1
+data = "docs/experiments/walk2d_fast/eval_curves.csv"
+variants = "fast fast_floor3e-5 per_thread_floor3e-5_seed1 per_thread_floor3e-5_seed2"
+title_of(i) = i == 1 ? "batched, floor 2e-5, seed 1" : \
+              i == 2 ? "batched, floor 3e-5, seed 1" : \
+              i == 3 ? "per-thread, floor 3e-5, seed 1" : \
+                       "per-thread, floor 3e-5, seed 2"
+set multiplot layout 1,2 title "Walk from 2D only (configs/walk2d_fast.yaml variants): Succ of each checkpoint, 40 rollouts"
+set xlabel "samples (millions)"
+set ylabel "Succ"
+plot for [i=1:words(variants)] data using (strcol(1) eq word(variants, i) ? $2 / 1e6 : NaN):4 \
+     with linespoints title title_of(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
+set xlabel "training wall time (min)"
+set arrow from 30, 0 to 30, 1 nohead dashtype 2 lc rgb "black"
+plot for [i=1:words(variants)] data using (strcol(1) eq word(variants, i) ? $3 / 60 : NaN):4 \
+     with linespoints title title_of(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
+unset multiplot

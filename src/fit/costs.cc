@@ -1,0 +1,238 @@
+#include "fit/costs.h"
+
+#include <ceres/jet.h>
+
+#include <algorithm>
+#include <utility>
+
+namespace m2d {
+namespace {
+
+// A cost function whose Jacobians the cost writes itself (`Cost` has
+// Evaluate(blocks, residuals, jacobians)).
+template <typename Cost>
+class AnalyticCostFunction : public ceres::CostFunction {
+ public:
+  AnalyticCostFunction(Cost cost, const std::vector<int32_t>& block_sizes,
+                       int num_residuals)
+      : cost_(std::move(cost)) {
+    *mutable_parameter_block_sizes() = block_sizes;
+    set_num_residuals(num_residuals);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return cost_.Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  Cost cost_;
+};
+
+// A residual's value and its derivative in its argument, through the same
+// templated function the residual is defined by.
+template <typename Function>
+std::pair<double, double> ValueAndSlope(double x, const Function& function) {
+  using Jet1 = ceres::Jet<double, 1>;
+  const Jet1 y = function(Jet1(x, 0));
+  return {y.a, y.v[0]};
+}
+
+// The forward kinematics of one frame: points and their pose Jacobian.
+struct PosedPoints {
+  int columns = 0;
+  std::vector<double> points, jacobian;  // 3 per point; row-major rows
+
+  PosedPoints(const KinematicModel& model, const double* root_m,
+              const double* quaternion_wxyz, const double* hinges_rad)
+      : columns(PoseJacobianColumns(model)),
+        points(3 * (model.num_keypoints() + model.num_sole_points())),
+        jacobian(points.size() * columns) {
+    CharacterPointsWithJacobian(model, root_m, quaternion_wxyz, hinges_rad,
+                                points.data(), jacobian.data());
+  }
+
+  // Adds scale x gradient . d(point)/d(pose) to one residual's rows of the
+  // three pose blocks' Jacobians (root position, quaternion, hinges; each
+  // may be null), `gradient` being d(residual)/d(point).
+  void AddPoseRow(int point, const double* gradient, int residual, double scale,
+                  double* const* pose_jacobians, int num_hinges) const {
+    constexpr int kBlockStart[3] = {0, kRootPositionSize,
+                                    kRootPositionSize + kRootQuaternionSize};
+    const int block_size[3] = {kRootPositionSize, kRootQuaternionSize,
+                               num_hinges};
+    for (int b = 0; b < 3; ++b) {
+      if (pose_jacobians[b] == nullptr) continue;
+      double* row = pose_jacobians[b] + residual * block_size[b];
+      for (int c = 0; c < 3; ++c) {
+        const double factor = scale * gradient[c];
+        if (factor == 0.0) continue;
+        const double* source =
+            jacobian.data() + (3 * point + c) * columns + kBlockStart[b];
+        for (int k = 0; k < block_size[b]; ++k) row[k] += factor * source[k];
+      }
+    }
+  }
+};
+
+// Zeroes every requested Jacobian block (`rows` residuals each).
+void ZeroJacobians(double** jacobians, const std::vector<int32_t>& block_sizes,
+                   int rows) {
+  if (jacobians == nullptr) return;
+  for (size_t b = 0; b < block_sizes.size(); ++b) {
+    if (jacobians[b] != nullptr)
+      std::fill(jacobians[b], jacobians[b] + rows * block_sizes[b], 0.0);
+  }
+}
+
+std::vector<int32_t> FrameBlockSizes(const KinematicModel& model) {
+  return {1, 2, 3, kRootPositionSize, kRootQuaternionSize, model.num_hinges()};
+}
+
+std::vector<int32_t> SlideBlockSizes(const KinematicModel& model) {
+  const int32_t hinges = model.num_hinges();
+  return {kRootPositionSize, kRootQuaternionSize, hinges,
+          kRootPositionSize, kRootQuaternionSize, hinges};
+}
+
+}  // namespace
+
+bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
+                         double** jacobians) const {
+  // Outline: the frame's points and pose Jacobian; per used keypoint the
+  // projection with its derivatives in the camera and the point (Jets),
+  // chained through the robust residual; the floor, penetration and upright
+  // rows. Jacobian rows start at zero and terms add into them.
+  using Jet9 = ceres::Jet<double, 9>;
+  using Jet4 = ceres::Jet<double, 4>;
+  const int num_keypoints = model->num_keypoints();
+  const int num_soles = model->num_sole_points();
+  const int num_hinges = model->num_hinges();
+  const bool want = jacobians != nullptr;
+  ZeroJacobians(jacobians, FrameBlockSizes(*model), NumResiduals(*model));
+  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5]);
+  double* const no_pose[3] = {nullptr, nullptr, nullptr};
+  double* const* pose_jacobians = want ? jacobians + 3 : no_pose;
+
+  // Reprojection: residual rows 2j, 2j + 1.
+  const Jet9 focal(blocks[0][0], 0);
+  const Jet9 pitch_roll[2] = {Jet9(blocks[1][0], 1), Jet9(blocks[1][1], 2)};
+  const Jet9 centre[3] = {Jet9(blocks[2][0], 3), Jet9(blocks[2][1], 4),
+                          Jet9(blocks[2][2], 5)};
+  for (int j = 0; j < num_keypoints; ++j) {
+    if (weights[j] == 0.0) {
+      residuals[2 * j] = residuals[2 * j + 1] = 0.0;
+      continue;
+    }
+    const double* p = &posed.points[3 * j];
+    const Jet9 point[3] = {Jet9(p[0], 6), Jet9(p[1], 7), Jet9(p[2], 8)};
+    Jet9 pixel[2];
+    FitProject(focal, pitch_roll, centre, point, cx_px, cy_px, pixel);
+    for (int k = 0; k < 2; ++k) {
+      const int row = 2 * j + k;
+      const auto [value, slope] = ValueAndSlope(
+          (pixel[k].a - observed_px[j][k]) * inv_scale_px,
+          [&](const auto& e) { return GemanMcClureResidual(e, sigma); });
+      residuals[row] = weights[j] * value;
+      if (!want) continue;
+      const double d_pixel = weights[j] * slope * inv_scale_px;
+      const Eigen::Matrix<double, 9, 1>& d = pixel[k].v;
+      if (jacobians[0]) jacobians[0][row] = d_pixel * d[0];
+      if (jacobians[1]) {
+        for (int c = 0; c < 2; ++c)
+          jacobians[1][2 * row + c] = d_pixel * d[1 + c];
+      }
+      if (jacobians[2]) {
+        for (int c = 0; c < 3; ++c)
+          jacobians[2][3 * row + c] = d_pixel * d[3 + c];
+      }
+      const double gradient[3] = {d[6], d[7], d[8]};
+      posed.AddPoseRow(j, gradient, row, d_pixel, pose_jacobians, num_hinges);
+    }
+  }
+
+  // Floor (the lowest sole point) and penetration (each sole point).
+  double* out = residuals + 2 * num_keypoints;
+  const int ground_row = 2 * num_keypoints;
+  int lowest = 0;
+  for (int s = 0; s < num_soles; ++s) {
+    const double z = posed.points[3 * (num_keypoints + s) + 2];
+    if (z < posed.points[3 * (num_keypoints + lowest) + 2]) lowest = s;
+    out[1 + s] = z < 0.0 ? penetration_weight * z : 0.0;
+    if (want && z < 0.0) {
+      const double up[3] = {0, 0, 1};
+      posed.AddPoseRow(num_keypoints + s, up, ground_row + 1 + s,
+                       penetration_weight, pose_jacobians, num_hinges);
+    }
+  }
+  const auto [ground, ground_slope] = ValueAndSlope(
+      posed.points[3 * (num_keypoints + lowest) + 2],
+      [&](const auto& z) { return GemanMcClureResidual(z, airborne_m); });
+  out[0] = ground_weight * ground;
+  if (want) {
+    const double up[3] = {0, 0, 1};
+    posed.AddPoseRow(num_keypoints + lowest, up, ground_row,
+                     ground_weight * ground_slope, pose_jacobians, num_hinges);
+  }
+
+  // Upright: the horizontal part of the root's up axis (the rotation's third
+  // column), in the quaternion alone.
+  const int upright_row = ground_row + 1 + num_soles;
+  Jet4 q[4];
+  for (int k = 0; k < 4; ++k) q[k] = Jet4(blocks[4][k], k);
+  const Jet4 norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  const Jet4 upright[2] = {
+      upright_weight * 2.0 * (q[1] * q[3] + q[0] * q[2]) / norm2,
+      upright_weight * 2.0 * (q[2] * q[3] - q[0] * q[1]) / norm2};
+  for (int k = 0; k < 2; ++k) {
+    residuals[upright_row + k] = upright[k].a;
+    if (want && jacobians[4]) {
+      for (int c = 0; c < 4; ++c)
+        jacobians[4][4 * (upright_row + k) + c] = upright[k].v[c];
+    }
+  }
+  return true;
+}
+
+ceres::CostFunction* FrameCost::Create(FrameCost cost) {
+  const std::vector<int32_t> sizes = FrameBlockSizes(*cost.model);
+  const int num_residuals = NumResiduals(*cost.model);
+  return new AnalyticCostFunction<FrameCost>(std::move(cost), sizes,
+                                             num_residuals);
+}
+
+bool FootSlideCost::Evaluate(double const* const* blocks, double* residuals,
+                             double** jacobians) const {
+  // Outline: both frames' points and pose Jacobians; per sole point its
+  // weighted horizontal step, minus the first frame's rows and plus the
+  // second's.
+  const int num_keypoints = model->num_keypoints();
+  const int num_soles = model->num_sole_points();
+  const int num_hinges = model->num_hinges();
+  ZeroJacobians(jacobians, SlideBlockSizes(*model), 2 * num_soles);
+  const PosedPoints before(*model, blocks[0], blocks[1], blocks[2]);
+  const PosedPoints after(*model, blocks[3], blocks[4], blocks[5]);
+  for (int s = 0; s < num_soles; ++s) {
+    const int point = num_keypoints + s;
+    for (int k = 0; k < 2; ++k) {
+      const int row = 2 * s + k;
+      residuals[row] = contact_weights[s] * (after.points[3 * point + k] -
+                                             before.points[3 * point + k]);
+      if (jacobians == nullptr) continue;
+      const double axis[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, 0.0};
+      before.AddPoseRow(point, axis, row, -contact_weights[s], jacobians,
+                        num_hinges);
+      after.AddPoseRow(point, axis, row, contact_weights[s], jacobians + 3,
+                       num_hinges);
+    }
+  }
+  return true;
+}
+
+ceres::CostFunction* FootSlideCost::Create(FootSlideCost cost) {
+  const std::vector<int32_t> sizes = SlideBlockSizes(*cost.model);
+  const int num_residuals = 2 * cost.model->num_sole_points();
+  return new AnalyticCostFunction<FootSlideCost>(std::move(cost), sizes,
+                                                 num_residuals);
+}
+
+}  // namespace m2d
