@@ -105,14 +105,18 @@ void RolloutCollector::CollectPerThread(
 
 #pragma omp parallel num_threads(num_threads)
   {
-    const int k = omp_get_thread_num();
-    try {
-      Shard shard{num_envs * k / num_threads, num_envs * (k + 1) / num_threads,
-                  shard_generators_[k]};
-      CollectShard(policy, asi, shard, storage, last_values, &shard_finished[k],
-                   &shard_captures[k]);
-    } catch (...) {
-      shard_error[k] = std::current_exception();  // rethrown below
+    // Shards are independent, so a thread may run several in turn should
+    // OpenMP grant fewer threads than asked.
+    for (int k = omp_get_thread_num(); k < num_threads;
+         k += omp_get_num_threads()) {
+      try {
+        Shard shard{num_envs * k / num_threads,
+                    num_envs * (k + 1) / num_threads, shard_generators_[k]};
+        CollectShard(policy, asi, shard, storage, last_values,
+                     &shard_finished[k], &shard_captures[k]);
+      } catch (...) {
+        shard_error[k] = std::current_exception();  // rethrown below
+      }
     }
   }
   for (const std::exception_ptr& error : shard_error) {
