@@ -69,16 +69,18 @@ void AsiUpdater::Update(const Critic& critic, int iteration) {
     for (size_t i = 0; i < states.size(); ++i) {
       StateBuffer& buffer = initial_states_->buffer(states[i].buffer);
       if (!buffer.Insert(states[i].frame, states[i].state, score[i])) continue;
-      // Keep what the capture observed, for rescoring.
+      // Keep what the capture observed, for rescoring: find the entry the
+      // state went into.
       const int frame = states[i].frame;
       for (int e = 0; e < buffer.size(frame); ++e) {
-        if (!SameObservedState(buffer.entry(frame, e).state, states[i].state))
+        const SimState& kept = buffer.entry(frame, e).state;
+        if (kept.qpos != states[i].state.qpos ||
+            kept.qvel != states[i].state.qvel)
           continue;
-        ObservedEntry& observed = ObservedAt(states[i].buffer, frame, e);
-        observed.view = states[i].view;
-        KeepObservedState(states[i].state, &observed);
-        const float* row = captured_.observations.data() + i * observation_size;
-        observed.raw.assign(row, row + observation_size);
+        ObservedAt(states[i].buffer, frame, e)
+            .Keep(kept, states[i].view,
+                  captured_.observations.data() + i * observation_size,
+                  static_cast<int>(observation_size));
         break;
       }
     }
@@ -98,21 +100,6 @@ AsiUpdater::ObservedEntry& AsiUpdater::ObservedAt(int buffer, int frame,
     entries.resize(
         initial_states_->buffer(buffer).options().capacity_per_frame);
   return entries[entry];
-}
-
-void AsiUpdater::KeepObservedState(const SimState& state,
-                                   ObservedEntry* observed) {
-  observed->qpos = state.qpos;
-  observed->qvel = state.qvel;
-}
-
-bool AsiUpdater::SameObservedState(const SimState& state,
-                                   const ObservedEntry& observed) {
-  return state.qpos == observed.qpos && state.qvel == observed.qvel;
-}
-
-bool AsiUpdater::SameObservedState(const SimState& a, const SimState& b) {
-  return a.qpos == b.qpos && a.qvel == b.qvel;
 }
 
 void AsiUpdater::RescoreAll(const Critic& critic) {
@@ -157,15 +144,13 @@ void AsiUpdater::RescoreAll(const Critic& critic) {
                                 .state;
     ObservedEntry& observed = observed_[slot.buffer][slot.frame][slot.entry];
     float* row = batch.data() + k * observation_size;
-    if (observed.view == slot.view && SameObservedState(state, observed)) {
+    if (observed.Holds(state, slot.view)) {
       std::copy(observed.raw.begin(), observed.raw.end(), row);
       continue;
     }
     scoring_envs_[omp_get_thread_num()]->ResetTo(slot.view, slot.frame, state,
                                                  row);
-    observed.view = slot.view;
-    KeepObservedState(state, &observed);
-    observed.raw.assign(row, row + observation_size);
+    observed.Keep(state, slot.view, row, observation_size);
   }
 
   torch::Tensor raw = torch::from_blob(

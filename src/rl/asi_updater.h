@@ -68,14 +68,22 @@ class AsiUpdater {
     int view = -1;  // -1: never observed
     std::vector<double> qpos, qvel;
     std::vector<float> raw;
+
+    // Whether `raw` is the observation of `state` from `view`.
+    bool Holds(const SimState& state, int from_view) const {
+      return view == from_view && state.qpos == qpos && state.qvel == qvel;
+    }
+    void Keep(const SimState& state, int from_view, const float* row,
+              int size) {
+      view = from_view;
+      qpos = state.qpos;
+      qvel = state.qvel;
+      raw.assign(row, row + size);
+    }
   };
   // The kept observation of entry `entry` of `frame` in `buffer`, grown on
   // first use.
   ObservedEntry& ObservedAt(int buffer, int frame, int entry);
-  static void KeepObservedState(const SimState& state, ObservedEntry* observed);
-  static bool SameObservedState(const SimState& state,
-                                const ObservedEntry& observed);
-  static bool SameObservedState(const SimState& a, const SimState& b);
   void RescoreAll(const Critic& critic);
 
   AsiOptions options_;
