@@ -21,6 +21,8 @@ void AddTrainCommand(CLI::App& app, CommandRun* run);
 void AddEvalCommand(CLI::App& app, CommandRun* run);
 void AddFitCommand(CLI::App& app, CommandRun* run);
 void AddBenchCommand(CLI::App& app, CommandRun* run);
+// `gen train` and `generate`.
+void AddGenCommands(CLI::App& app, CommandRun* run);
 // `bench train`, registered by AddBenchCommand on its `bench` subcommand.
 void AddBenchTrainSubcommand(CLI::App* bench, CommandRun* run);
 // `bench fit`, likewise.

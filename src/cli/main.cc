@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   m2d::cli::AddEvalCommand(app, &run);
   m2d::cli::AddFitCommand(app, &run);
   m2d::cli::AddBenchCommand(app, &run);
+  m2d::cli::AddGenCommands(app, &run);
   // No command, or one that does not exist: say so and list the commands
   // (CLI11 alone says "A subcommand is required" for both).
   std::string commands;

@@ -65,4 +65,12 @@ std::string SettingsTableMarkdown(const std::vector<SettingRow>& rows) {
   return table;
 }
 
+YAML::Node ParseYamlText(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source, std::string("malformed YAML: ") + e.what());
+  }
+}
+
 }  // namespace m2d

@@ -193,6 +193,37 @@ void AppendSettingRows(const std::string& section, const Options& defaults,
 // The rows as a Markdown table (setting | default | allowed | meaning).
 std::string SettingsTableMarkdown(const std::vector<SettingRow>& rows);
 
+// YAML text as a node; InputError naming `source` when it is malformed.
+YAML::Node ParseYamlText(const std::string& text, const std::string& source);
+
+// A config made of sections, each an options struct: `for_each_section(
+// config, visit)` calls visit(key, options) for every section in order.
+// Every setting of every section as YAML (what checkpoints embed).
+template <typename Config, typename ForEachSection>
+std::string SectionsToYaml(const Config& config,
+                           ForEachSection for_each_section) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  for_each_section(config, [&](const char* key, const auto& options) {
+    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    WriteFields(out, options);
+    out << YAML::EndMap;
+  });
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+// The reference table of every setting of a default-constructed Config.
+template <typename Config, typename ForEachSection>
+std::string SectionsSettingsReference(ForEachSection for_each_section) {
+  const Config defaults;
+  std::vector<SettingRow> rows;
+  for_each_section(defaults, [&](const char* key, const auto& options) {
+    AppendSettingRows(key, options, &rows);
+  });
+  return SettingsTableMarkdown(rows);
+}
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_COMMON_YAML_FIELDS_H_

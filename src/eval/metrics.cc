@@ -1,8 +1,10 @@
 #include "eval/metrics.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 namespace m2d {
 namespace {
@@ -109,6 +111,59 @@ double MeanJerk(const KeypointFrames& positions, double fps) {
     }
   }
   return sum / count / 1000.0;
+}
+
+FeatureGaussian FitFeatureGaussian(const Eigen::MatrixXd& features) {
+  FeatureGaussian gaussian;
+  gaussian.count = static_cast<int>(features.rows());
+  gaussian.mean = features.colwise().mean().transpose();
+  const Eigen::MatrixXd centred =
+      features.rowwise() - gaussian.mean.transpose();
+  gaussian.covariance =
+      centred.transpose() * centred /
+      std::max<double>(1.0, static_cast<double>(features.rows()));
+  return gaussian;
+}
+
+namespace {
+
+// The symmetric square root of a symmetric positive semi-definite matrix.
+Eigen::MatrixXd SymmetricSqrt(const Eigen::MatrixXd& matrix) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(matrix);
+  const Eigen::VectorXd roots = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  return solver.eigenvectors() * roots.asDiagonal() *
+         solver.eigenvectors().transpose();
+}
+
+}  // namespace
+
+double FrechetDistance(const FeatureGaussian& a, const FeatureGaussian& b) {
+  // Tr((Σa Σb)^½) = Tr((Σa^½ Σb Σa^½)^½): the inner matrix is symmetric
+  // positive semi-definite, so its root is real.
+  const Eigen::MatrixXd root_a = SymmetricSqrt(a.covariance);
+  const Eigen::MatrixXd inner = root_a * b.covariance * root_a;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(
+      0.5 * (inner + inner.transpose()));
+  const double cross_trace =
+      solver.eigenvalues().cwiseMax(0.0).cwiseSqrt().sum();
+  return (a.mean - b.mean).squaredNorm() + a.covariance.trace() +
+         b.covariance.trace() - 2.0 * cross_trace;
+}
+
+double MeanPairDistance(const Eigen::MatrixXd& features, int pairs,
+                        uint64_t seed) {
+  const int rows = static_cast<int>(features.rows());
+  if (rows < 2 || pairs <= 0) return 0.0;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> pick(0, rows - 1);
+  double sum = 0.0;
+  for (int p = 0; p < pairs; ++p) {
+    const int i = pick(rng);
+    int j = pick(rng);
+    while (j == i) j = pick(rng);
+    sum += (features.row(i) - features.row(j)).norm();
+  }
+  return sum / pairs;
 }
 
 }  // namespace m2d

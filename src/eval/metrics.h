@@ -4,6 +4,7 @@
 #define MIMIC2D_EVAL_METRICS_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "motion/layout.h"
@@ -42,6 +43,25 @@ double ProcrustesAlignedError(const KeypointFrames& simulated,
 // time derivative of positions (finite differences at `fps`), in units of
 // 10^3 m/s^3 as reported in the paper's tables. 0 for fewer than 4 frames.
 double MeanJerk(const KeypointFrames& positions, double fps);
+
+// A Gaussian fitted to feature vectors (one per row): what FID compares.
+struct FeatureGaussian {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd covariance;  // maximum likelihood (divides by N)
+  int count = 0;
+};
+FeatureGaussian FitFeatureGaussian(const Eigen::MatrixXd& features);
+
+// The Fréchet distance between two Gaussians, FID when the features come
+// from a motion encoder: |μa − μb|² + Tr(Σa + Σb − 2 (Σa^½ Σb Σa^½)^½).
+// The matrix square roots come from symmetric eigendecompositions (small
+// negative eigenvalues of round-off clamped to 0).
+double FrechetDistance(const FeatureGaussian& a, const FeatureGaussian& b);
+
+// Diversity: the mean distance between `pairs` random pairs of rows
+// (distinct rows, drawn with `seed`); 0 with fewer than 2 rows.
+double MeanPairDistance(const Eigen::MatrixXd& features, int pairs,
+                        uint64_t seed);
 
 }  // namespace m2d
 

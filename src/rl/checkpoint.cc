@@ -13,20 +13,12 @@
 #include "common/error.h"
 #include "common/file_io.h"
 #include "common/hash.h"
+#include "rl/archive_file.h"
 
 namespace m2d {
 namespace {
 
-// A checkpoint file is LibTorch's zip archive followed by a trailer: this
-// magic and a 64-bit FNV-1a hash of the archive bytes. The archive stores
-// tensors uncompressed and LibTorch 1.13 does not check its CRCs, so a
-// flipped bit would otherwise load as a silently different weight. The
-// trailer is required: LibTorch's archive reader is not safe on damaged
-// files (fuzzing crashed its TorchScript type parser with a SEGV within a
-// few hundred mutations, docs/reliability.md), so no byte reaches it
-// unverified.
-constexpr char kTrailerMagic[8] = {'M', '2', 'D', 'C', 'K', 'S', 'U', 'M'};
-constexpr size_t kTrailerSize = sizeof(kTrailerMagic) + sizeof(uint64_t);
+constexpr char kCheckpointFormat[] = "mimic2d.checkpoint.v1";
 
 // A SimState as one row of doubles, in a fixed field order; sizes come from
 // a template state of the same model.
@@ -71,7 +63,6 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
                     const InitialStates* initial_states,
                     const SimState& state_template) {
   torch::serialize::OutputArchive archive;
-  archive.write("format", c10::IValue(std::string("mimic2d.checkpoint.v1")));
   archive.write("config_yaml", c10::IValue(TrainConfigToYaml(config)));
   const ObservationLayout& layout = model->layout();
   archive.write("layout",
@@ -128,86 +119,13 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
     }
   }
 
-  // Serialized in memory, then written atomically: LibTorch writing to a
-  // full disk aborted the process (its zip writer throws from a destructor)
-  // and left a partial file; WriteFileAtomic reports the error by name and
-  // leaves the previous checkpoint in place.
-  std::ostringstream bytes;
-  try {
-    archive.save_to(bytes);
-  } catch (const c10::Error& e) {
-    throw InputError(path, "cannot serialize checkpoint: " +
-                               std::string(e.what_without_backtrace()));
-  }
-  std::string contents = bytes.str();
-  const uint64_t hash = Fnv1a64(contents.data(), contents.size());
-  contents.append(kTrailerMagic, sizeof(kTrailerMagic));
-  contents.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
-  const std::string folder = ParentDirectory(path);
-  if (!std::filesystem::is_directory(folder)) {
-    throw InputError(
-        path, "cannot write checkpoint: folder " + folder + " does not exist");
-  }
-  try {
-    WriteFileAtomic(path, contents);
-  } catch (const InputError& e) {
-    throw InputError(path, "cannot write checkpoint: " + e.problem() +
-                               "; the previous checkpoint is unchanged");
-  }
+  WriteArchiveFile(path, kCheckpointFormat, archive);
 }
 
 namespace {
 
-// LibTorch's archive reader reports a malformed file with c10::Error,
-// std::out_of_range, std::bad_alloc and others; every read of a checkpoint
-// goes through this, so the user always sees the file and the problem.
-template <typename Read>
-auto NamingCheckpointErrors(const std::string& path, const std::string& problem,
-                            Read read) -> decltype(read()) {
-  try {
-    return read();
-  } catch (const InputError&) {
-    throw;
-  } catch (const ConfigError& e) {
-    throw InputError(path, problem + " (" + e.what() + ")");
-  } catch (const c10::Error& e) {
-    throw InputError(path, problem + " (" + e.what_without_backtrace() + ")");
-  } catch (const std::exception& e) {
-    throw InputError(path, problem + " (" + e.what() + ")");
-  }
-}
-
 torch::serialize::InputArchive OpenArchive(const std::string& path) {
-  const std::string contents = ReadFileText(path);
-  if (contents.size() < kTrailerSize ||
-      std::memcmp(contents.data() + contents.size() - kTrailerSize,
-                  kTrailerMagic, sizeof(kTrailerMagic)) != 0) {
-    throw InputError(path,
-                     "not a mimic2d checkpoint, or a damaged one: it does not "
-                     "end in mimic2d's checksum trailer (a partly copied "
-                     "file, or another program's)");
-  }
-  const size_t archive_size = contents.size() - kTrailerSize;
-  uint64_t stored = 0;
-  std::memcpy(&stored, contents.data() + archive_size + sizeof(kTrailerMagic),
-              sizeof(stored));
-  if (Fnv1a64(contents.data(), archive_size) != stored) {
-    throw InputError(path,
-                     "checkpoint is corrupt (its checksum does not match "
-                     "its contents: a damaged or partly copied file)");
-  }
-  torch::serialize::InputArchive archive;
-  NamingCheckpointErrors(path, "not a readable checkpoint", [&] {
-    archive.load_from(contents.data(), archive_size);
-  });
-  c10::IValue format;
-  const bool is_ours =
-      NamingCheckpointErrors(path, "not a mimic2d checkpoint", [&] {
-        return archive.try_read("format", format) && format.isString() &&
-               format.toStringRef() == "mimic2d.checkpoint.v1";
-      });
-  if (!is_ours) throw InputError(path, "not a mimic2d checkpoint");
-  return archive;
+  return ReadArchiveFile(path, kCheckpointFormat);
 }
 
 }  // namespace
@@ -215,7 +133,7 @@ torch::serialize::InputArchive OpenArchive(const std::string& path) {
 TrainConfig ReadCheckpointConfig(const std::string& path) {
   torch::serialize::InputArchive archive = OpenArchive(path);
   c10::IValue text;
-  NamingCheckpointErrors(path, "no readable embedded config", [&] {
+  NamingArchiveErrors(path, "no readable embedded config", [&] {
     archive.read("config_yaml", text);
     if (!text.isString()) throw InputError(path, "embedded config is not text");
   });
@@ -225,7 +143,7 @@ TrainConfig ReadCheckpointConfig(const std::string& path) {
 ObservationLayout ReadCheckpointLayout(const std::string& path,
                                        int* action_size) {
   torch::serialize::InputArchive archive = OpenArchive(path);
-  return NamingCheckpointErrors(path, "malformed layout", [&] {
+  return NamingArchiveErrors(path, "malformed layout", [&] {
     torch::Tensor values;
     archive.read("layout", values);
     values = values.to(torch::kInt64).flatten();
@@ -448,30 +366,28 @@ void LoadCheckpointStateBuffers(const std::string& path,
                                 InitialStates* initial_states,
                                 const SimState& state_template) {
   torch::serialize::InputArchive archive = OpenArchive(path);
-  NamingCheckpointErrors(
-      path, "initial-state buffers do not fit this task", [&] {
-        torch::Tensor saved_buffers;
-        if (!archive.try_read("asi_buffers", saved_buffers)) {
-          throw InputError(path, "holds no initial-state buffers");
-        }
-        // Only buffers known to belong to this reference: a checkpoint from
-        // before fingerprints cannot say which motion its buffers are of.
-        const std::optional<uint64_t> fingerprint =
-            SavedReferenceFingerprint(archive);
-        if (!fingerprint) {
-          throw InputError(
-              path,
-              "its initial-state buffers carry no reference "
-              "fingerprint (an older checkpoint): cannot tell which "
-              "motion they belong to");
-        }
-        if (*fingerprint != initial_states->reference_fingerprint()) {
-          throw InputError(path,
-                           "its initial-state buffers were filled for other "
-                           "reference motion than these bundles'");
-        }
-        RestoreStateBuffers(path, archive, initial_states, state_template);
-      });
+  NamingArchiveErrors(path, "initial-state buffers do not fit this task", [&] {
+    torch::Tensor saved_buffers;
+    if (!archive.try_read("asi_buffers", saved_buffers)) {
+      throw InputError(path, "holds no initial-state buffers");
+    }
+    // Only buffers known to belong to this reference: a checkpoint from
+    // before fingerprints cannot say which motion its buffers are of.
+    const std::optional<uint64_t> fingerprint =
+        SavedReferenceFingerprint(archive);
+    if (!fingerprint) {
+      throw InputError(path,
+                       "its initial-state buffers carry no reference "
+                       "fingerprint (an older checkpoint): cannot tell which "
+                       "motion they belong to");
+    }
+    if (*fingerprint != initial_states->reference_fingerprint()) {
+      throw InputError(path,
+                       "its initial-state buffers were filled for other "
+                       "reference motion than these bundles'");
+    }
+    RestoreStateBuffers(path, archive, initial_states, state_template);
+  });
 }
 
 }  // namespace m2d

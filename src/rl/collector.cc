@@ -33,6 +33,9 @@ void RolloutCollector::CollectBatched(ActorCritic& policy, AsiUpdater* asi,
   // truncated episodes' last observations into their reward, offer visited
   // states to ASI. Then GAE over the batch.
   torch::NoGradGuard no_grad;
+  // One scope for the rollout: the weights are cast to the training
+  // precision once, not at every step (PrecisionScope).
+  PrecisionScope precision(options_.training_precision);
   const int num_envs = envs_.num_envs();
   const int observation_size = envs_.observation_size();
   const int action_size = envs_.action_size();
@@ -67,7 +70,8 @@ void RolloutCollector::CollectBatched(ActorCritic& policy, AsiUpdater* asi,
   }
   torch::Tensor last_raw =
       torch::from_blob(envs_.observations(), {num_envs, observation_size});
-  torch::Tensor last_values = policy->Value(normalized(last_raw));
+  torch::Tensor last_values =
+      policy->Value(normalized(last_raw)).to(torch::kFloat);
   ComputeGae(storage.rewards, storage.values, storage.dones, last_values,
              discount, options_.gae_lambda, &storage.advantages,
              &storage.returns);
@@ -148,6 +152,7 @@ void RolloutCollector::CollectShard(ActorCritic& policy, AsiUpdater* asi,
   // Grad mode and autocast are per thread: set both here. LibTorch runs
   // single-threaded inside this OpenMP region.
   torch::NoGradGuard no_grad;
+  PrecisionScope precision(options_.training_precision);
   const int64_t begin = shard.begin, rows = shard.end - shard.begin;
   const int observation_size = envs_.observation_size();
   const int action_size = envs_.action_size();
@@ -207,6 +212,7 @@ void RolloutCollector::RecordStepOutcome(ActorCritic& policy, int begin,
       policy
           ->Value(options_.normalize_observations ? policy->Normalize(final_raw)
                                                   : final_raw)
+          .to(torch::kFloat)
           .contiguous();
   const float* value = final_value.data_ptr<float>();
   for (size_t r = 0; r < truncated_rows.size(); ++r) {

@@ -73,6 +73,12 @@ TORCH_MODULE(ActorCritic);
 // behavior policy's stored log-probabilities and the update's agree: with
 // sigma = 0.05, a mean rounded differently would read as a policy ratio
 // several percent from 1 before any step.
+//
+// Scopes nest: one opened while another is open on the thread does nothing.
+// Autocast keeps each weight's bfloat16 copy until the outermost scope
+// closes, so a scope around a whole rollout (weights fixed) casts the
+// weights once instead of at every step; the update opens one per gradient
+// step, as its weights change after each.
 class PrecisionScope {
  public:
   explicit PrecisionScope(TrainingPrecision precision);

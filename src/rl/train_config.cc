@@ -181,34 +181,17 @@ TrainConfig LoadTrainConfig(const std::string& yaml_path) {
 
 TrainConfig LoadTrainConfigText(const std::string& yaml_text,
                                 const std::string& source) {
-  YAML::Node node;
-  try {
-    node = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source, std::string("malformed YAML: ") + e.what());
-  }
-  return ParseTrainConfigNamingErrors(node, source);
+  return ParseTrainConfigNamingErrors(ParseYamlText(yaml_text, source), source);
 }
 
 std::string TrainConfigToYaml(const TrainConfig& config) {
-  YAML::Emitter out;
-  out << YAML::BeginMap;
-  ForEachSection(config, [&](const char* key, const auto& options) {
-    out << YAML::Key << key << YAML::Value << YAML::BeginMap;
-    WriteFields(out, options);
-    out << YAML::EndMap;
-  });
-  out << YAML::EndMap;
-  return std::string(out.c_str()) + "\n";
+  return SectionsToYaml(
+      config, [](const auto& c, auto visit) { ForEachSection(c, visit); });
 }
 
 std::string TrainSettingsReference() {
-  const TrainConfig defaults;
-  std::vector<SettingRow> rows;
-  ForEachSection(defaults, [&](const char* key, const auto& options) {
-    AppendSettingRows(key, options, &rows);
-  });
-  return SettingsTableMarkdown(rows);
+  return SectionsSettingsReference<TrainConfig>(
+      [](const auto& c, auto visit) { ForEachSection(c, visit); });
 }
 
 }  // namespace m2d

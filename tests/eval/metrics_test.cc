@@ -301,5 +301,45 @@ TEST(AggregateRows, NoEpisodesGiveAnEmptyAllRow) {
   EXPECT_EQ(all.e3d_mm, -1.0);
 }
 
+TEST(Metrics, FrechetDistanceMatchesClosedForms) {
+  // Identical Gaussians: 0. One dimension: (μa − μb)² + (σa − σb)².
+  FeatureGaussian a{Eigen::VectorXd::Constant(1, 1.0),
+                    Eigen::MatrixXd::Constant(1, 1, 4.0), 10};
+  FeatureGaussian b{Eigen::VectorXd::Constant(1, 3.0),
+                    Eigen::MatrixXd::Constant(1, 1, 9.0), 10};
+  EXPECT_NEAR(FrechetDistance(a, a), 0.0, 1e-9);
+  EXPECT_NEAR(FrechetDistance(a, b), 4.0 + 1.0, 1e-9);
+  // Commuting (diagonal) covariances: per axis, summed.
+  FeatureGaussian c{Eigen::Vector3d(0, 0, 0),
+                    Eigen::Vector3d(1, 4, 9).asDiagonal(), 10};
+  FeatureGaussian d{Eigen::Vector3d(1, 0, 2),
+                    Eigen::Vector3d(4, 4, 1).asDiagonal(), 10};
+  EXPECT_NEAR(FrechetDistance(c, d), 5.0 + 1.0 + 0.0 + 4.0, 1e-9);
+  // Symmetric, and invariant to a rotation of both.
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())
+          .toRotationMatrix();
+  FeatureGaussian rc{rotation * c.mean,
+                     rotation * c.covariance * rotation.transpose(), 10};
+  FeatureGaussian rd{rotation * d.mean,
+                     rotation * d.covariance * rotation.transpose(), 10};
+  EXPECT_NEAR(FrechetDistance(d, c), FrechetDistance(c, d), 1e-9);
+  EXPECT_NEAR(FrechetDistance(rc, rd), FrechetDistance(c, d), 1e-9);
+}
+
+TEST(Metrics, FeatureGaussianAndPairDistance) {
+  Eigen::MatrixXd rows(4, 2);
+  rows << 0, 0, 2, 0, 0, 2, 2, 2;
+  const FeatureGaussian g = FitFeatureGaussian(rows);
+  EXPECT_TRUE(g.mean.isApprox(Eigen::Vector2d(1, 1)));
+  EXPECT_TRUE(g.covariance.isApprox(Eigen::Matrix2d::Identity()));
+  // Pairs of distinct corners of a 2-square: 2 (sides) or 2√2 (diagonals).
+  const double mean = MeanPairDistance(rows, 3000, 1);
+  EXPECT_GT(mean, 2.0);
+  EXPECT_LT(mean, 2.0 * std::sqrt(2.0));
+  EXPECT_NEAR(mean, (4 * 2.0 + 2 * 2.0 * std::sqrt(2.0)) / 6, 0.05);
+  EXPECT_EQ(MeanPairDistance(rows.topRows(1), 10, 1), 0.0);
+}
+
 }  // namespace
 }  // namespace m2d

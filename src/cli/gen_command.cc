@@ -1,0 +1,296 @@
+// cli: `mimic2d gen train` — learn the 2D motion generator (tokenizer, then
+// prior) from a config; `mimic2d generate` — stream generated 2D motion into
+// a clip placed under a chosen camera view.
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "camera/rig.h"
+#include "cli/commands.h"
+#include "cli/motion_source.h"
+#include "common/error.h"
+#include "common/file_io.h"
+#include "gen/gen_config.h"
+#include "gen/gen_trainer.h"
+#include "gen/generator.h"
+#include "motion/clip_io.h"
+
+namespace m2d::cli {
+namespace {
+
+std::atomic<bool> g_gen_stop_requested{false};
+void RequestGenStop(int) { g_gen_stop_requested.store(true); }
+
+struct GenTrainArgs {
+  std::string config_path;
+  bool resume = false;
+  bool list_settings = false;
+};
+
+// The dataset of `motions` (files) seen from a config's views.
+GenDataset LoadGenDataset(const GenConfig& config,
+                          const std::vector<std::string>& motions) {
+  std::vector<GenMotionSource> sources;
+  for (const std::string& path : motions) {
+    MotionSourceArgs args;
+    args.path = path;
+    LoadedMotion loaded = LoadMotionSource(args);
+    sources.push_back({std::filesystem::path(path).stem().string(),
+                       std::move(loaded.motion),
+                       std::move(loaded.keypoint_map)});
+  }
+  return BuildGenDataset(sources, config.data.views, config.data.fps,
+                         config.data.loop_to_s);
+}
+
+int RunGenTrain(const GenTrainArgs& args) {
+  if (args.list_settings) {
+    std::printf("%s", GenSettingsReference().c_str());
+    return 0;
+  }
+  if (args.config_path.empty())
+    throw InputError("",
+                     "gen train: give a config (e.g. configs/gen/clips.yaml)");
+  const GenConfig config = LoadGenConfig(args.config_path);
+  std::signal(SIGINT, RequestGenStop);
+  std::signal(SIGTERM, RequestGenStop);
+  const GenDataset dataset = LoadGenDataset(config, config.data.motions);
+  std::printf(
+      "gen train %s -> %s: %zu sequences (%zu motions x %d views), %lld "
+      "frames at %.0f fps (%.1f min of 2D)\n",
+      args.config_path.c_str(), config.run.run_dir.c_str(),
+      dataset.sequences.size(), config.data.motions.size(),
+      config.data.views.num_views(),
+      static_cast<long long>(dataset.num_frames()), dataset.fps,
+      dataset.num_frames() / dataset.fps / 60.0);
+  auto report = [](const GenProgress& p) {
+    const double eta_s =
+        p.step > 0 ? p.seconds / p.step * (p.steps - p.step) : 0.0;
+    if (p.stage == GenStage::kTokenizer) {
+      std::printf(
+          "tokenizer %7lld/%lld | loss %.4f (canonical %.4f absolute %.4f "
+          "velocity %.4f commit %.4f) | perplexity %6.1f, %3d codes used, %3d "
+          "reset | lr %.1e | %.1f steps/s | ETA %.0f s\n",
+          static_cast<long long>(p.step), static_cast<long long>(p.steps),
+          p.loss, p.canonical_loss, p.absolute_loss, p.velocity_loss,
+          p.commit_loss, p.perplexity, p.used_codes, p.reset_codes,
+          p.learning_rate, p.step / std::max(1e-9, p.seconds), eta_s);
+    } else {
+      std::printf(
+          "prior     %7lld/%lld | cross-entropy %.4f nats | next-code "
+          "accuracy %5.1f%% | lr %.1e | %.1f steps/s | ETA %.0f s\n",
+          static_cast<long long>(p.step), static_cast<long long>(p.steps),
+          p.loss, 100.0 * p.accuracy, p.learning_rate,
+          p.step / std::max(1e-9, p.seconds), eta_s);
+    }
+    std::fflush(stdout);
+  };
+  const GenTrainSummary summary = TrainGenerator(config, dataset, args.resume,
+                                                 &g_gen_stop_requested, report);
+  std::printf("%s", summary.BriefReport().c_str());
+  return summary.interrupted ? 130 : 0;
+}
+
+struct GenerateArgs {
+  std::string run_dir;  // holds tokenizer.pt and prior.pt
+  std::string output;
+  double seconds = 10.0;
+  uint64_t seed = 1;
+  double temperature = 1.0;
+  int top_k = 0;
+  std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
+  double focal_px = 1000.0;
+};
+
+// The first frame's root and scale: the character standing at the origin,
+// seen from the chosen view (what the tracker starts from).
+void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
+                       double* scale_px, PinholeCamera* camera) {
+  RigOptions rig;
+  rig.num_views = 1;
+  rig.first_azimuth_deg = args.view[0];
+  rig.elevation_deg = args.view[1];
+  rig.distance_m = args.view[2];
+  rig.focal_px = args.focal_px;
+  rig.Validate();
+  *camera = MakeRig(rig).front().camera;
+  auto skeleton = std::make_shared<const Skeleton>(
+      LoadSkeleton(AssetPath("skeletons/humanoid.yaml")));
+  const KeypointMap map =
+      LoadKeypointMap(AssetPath("skeletons/humanoid.coco17.yaml"), *skeleton);
+  Pose3D rest;
+  rest.local_rotations.assign(skeleton->num_joints(),
+                              Eigen::Quaterniond::Identity());
+  std::vector<Eigen::Vector3d> points = KeypointPositions(*skeleton, map, rest);
+  double lowest_m = points.front().z();
+  for (const auto& point : points) lowest_m = std::min(lowest_m, point.z());
+  Clip2D frame;
+  frame.keypoints = KeypointTrack(1, static_cast<int>(points.size()));
+  for (size_t j = 0; j < points.size(); ++j) {
+    const Projection p =
+        camera->Project(points[j] - Eigen::Vector3d(0, 0, lowest_m));
+    frame.keypoints.at(0, static_cast<int>(j)) = {p.pixel_px.x(),
+                                                  p.pixel_px.y(), 1.0};
+  }
+  if (!RootAndScale(frame.keypoints.frame(0), *frame.layout, root_px,
+                    scale_px)) {
+    throw ConfigError(
+        "generate: the standing character is not visible from "
+        "--view");
+  }
+}
+
+int RunGenerate(const GenerateArgs& args) {
+  if (args.view.size() != 3)
+    throw ConfigError("generate: --view takes azimuth,elevation,distance");
+  SamplingOptions sampling;
+  sampling.temperature = args.temperature;
+  sampling.top_k = args.top_k;
+  const GeneratedMotion motion =
+      GenerateMotion(args.run_dir, args.seconds, sampling, args.seed);
+  const int frames = motion.num_frames;
+  const double fps = motion.fps;
+
+  Eigen::Vector2d root_px;
+  double scale_px = 0.0;
+  PinholeCamera camera;
+  StandingPlacement(args, &root_px, &scale_px, &camera);
+  Clip2D clip = FromCanonical(CanonicalFromFeatures(
+      motion.rows.data(), frames, Coco17Layout(), fps, root_px, scale_px));
+  WriteClip(args.output, clip);
+  std::printf(
+      "wrote %s: %d frames at %.0f fps (%.1f s) from %d codes, generated in "
+      "%.2f s (%.0fx real time)\n",
+      args.output.c_str(), frames, fps, frames / fps, motion.num_codes,
+      motion.generation_s, frames / fps / std::max(1e-9, motion.generation_s));
+  return 0;
+}
+
+struct GenEvalArgs {
+  std::string run_dir;
+  std::string output;
+  // Real motion capture the generator never saw (Debian's
+  // assimp-testmodels: CMU subject 1, playground).
+  std::vector<std::string> held_apart = {
+      "/usr/share/assimp/models/BVH/01_01.bvh",
+      "/usr/share/assimp/models/BVH/01_03.bvh"};
+  GeneratorEvalOptions options;
+};
+
+int RunGenEval(const GenEvalArgs& args) {
+  const GenConfig config = ReadGeneratorConfig(args.run_dir);
+  std::printf(
+      "gen eval %s: %d generations x %.0f s; encoder on %zu held-apart "
+      "motions\n",
+      args.run_dir.c_str(), args.options.generations, args.options.seconds,
+      args.held_apart.size());
+  std::fflush(stdout);
+  const GenDataset real = LoadGenDataset(config, config.data.motions);
+  const GenDataset held_apart = LoadGenDataset(config, args.held_apart);
+  const GeneratorEvalResult result =
+      EvaluateGenerator(args.run_dir, real, held_apart, args.options);
+  std::printf("%s", result.BriefReport().c_str());
+  if (!args.output.empty()) {
+    nlohmann::json json = {{"run_dir", args.run_dir},
+                           {"generations", args.options.generations},
+                           {"seconds", args.options.seconds},
+                           {"temperature", args.options.sampling.temperature},
+                           {"top_k", args.options.sampling.top_k},
+                           {"held_apart", args.held_apart},
+                           {"fid", result.fid},
+                           {"fid_floor", result.fid_floor},
+                           {"diversity_real", result.diversity_real},
+                           {"diversity_generated", result.diversity_generated},
+                           {"real_windows", result.real_windows},
+                           {"held_apart_windows", result.held_apart_windows},
+                           {"generated_windows", result.generated_windows},
+                           {"encoder_loss", result.encoder_loss},
+                           {"realtime_factor", result.realtime_factor}};
+    WriteFileAtomic(args.output, json.dump(2) + "\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddGenCommands(CLI::App& app, CommandRun* run) {
+  CLI::App* gen =
+      app.add_subcommand("gen", "The 2D motion generator (VQ-VAE + GPT)");
+  gen->require_subcommand(1);
+  auto train_args = std::make_shared<GenTrainArgs>();
+  CLI::App* train = gen->add_subcommand(
+      "train", "Train the tokenizer, then the prior, from a YAML config");
+  train
+      ->add_option("config", train_args->config_path,
+                   "Generator config (YAML), e.g. configs/gen/clips.yaml")
+      ->check(CLI::ExistingFile);
+  train->add_flag("--resume", train_args->resume,
+                  "Continue from <run_dir>/tokenizer.pt and prior.pt");
+  train->add_flag("--list-settings", train_args->list_settings,
+                  "Print every config setting (Markdown) and exit");
+  train->callback([run, train_args] {
+    *run = [train_args] { return RunGenTrain(*train_args); };
+  });
+
+  auto eval_args = std::make_shared<GenEvalArgs>();
+  CLI::App* eval = gen->add_subcommand(
+      "eval",
+      "FID of generated against real 2D motion (with the real-vs-real "
+      "floor), diversity and generation speed");
+  eval->add_option("run_dir", eval_args->run_dir,
+                   "The generator's run folder (tokenizer.pt, prior.pt)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  eval->add_option("--generations", eval_args->options.generations,
+                   "Independent generations (seeds 1..N)");
+  eval->add_option("--seconds", eval_args->options.seconds,
+                   "Length of each generation (s)");
+  eval->add_option("--temperature", eval_args->options.sampling.temperature,
+                   "Sampling temperature");
+  eval->add_option("--top-k", eval_args->options.sampling.top_k,
+                   "Sample among the k likeliest codes (0: all)");
+  eval->add_option("--held-apart", eval_args->held_apart,
+                   "Motions the feature encoder is trained on (never the "
+                   "generator's)")
+      ->delimiter(',');
+  eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
+                   "Training steps of the feature encoder");
+  eval->add_option("-o,--output", eval_args->output, "Figures as JSON");
+  eval->callback([run, eval_args] {
+    *run = [eval_args] { return RunGenEval(*eval_args); };
+  });
+
+  auto generate_args = std::make_shared<GenerateArgs>();
+  CLI::App* generate = app.add_subcommand(
+      "generate", "Generate 2D motion with a trained generator into a clip");
+  generate
+      ->add_option("run_dir", generate_args->run_dir,
+                   "The generator's run folder (tokenizer.pt, prior.pt)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  generate
+      ->add_option("-o,--output", generate_args->output, "Clip to write (JSON)")
+      ->required();
+  generate->add_option("--seconds", generate_args->seconds,
+                       "Length of the generated motion (s)");
+  generate->add_option("--seed", generate_args->seed, "Sampling seed");
+  generate->add_option("--temperature", generate_args->temperature,
+                       "Sampling temperature (> 0; lower is greedier)");
+  generate->add_option("--top-k", generate_args->top_k,
+                       "Sample among the k likeliest codes (0: all)");
+  generate
+      ->add_option("--view", generate_args->view,
+                   "Camera azimuth (deg), elevation (deg), distance (m)")
+      ->delimiter(',')
+      ->expected(3);
+  generate->add_option("--focal", generate_args->focal_px,
+                       "Camera focal length (px)");
+  generate->callback([run, generate_args] {
+    *run = [generate_args] { return RunGenerate(*generate_args); };
+  });
+}
+
+}  // namespace m2d::cli

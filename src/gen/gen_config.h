@@ -1,0 +1,177 @@
+// gen: the generator's settings — data, tokenizer (VQ-VAE), prior (GPT)
+// and run — each a typed section of one YAML file (configs/gen_*.yaml).
+// This header does not include LibTorch.
+#ifndef MIMIC2D_GEN_GEN_CONFIG_H_
+#define MIMIC2D_GEN_GEN_CONFIG_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/settings.h"
+#include "gen/motion_dataset.h"
+
+namespace m2d {
+
+// What the generator learns from: 3D motions projected into many views.
+struct GenDataOptions {
+  // DeepMimic .txt motions (the humanoid skeleton) or CMU .bvh files,
+  // relative to the working directory as every path of a config.
+  std::vector<std::string> motions = {
+      "assets/motions/deepmimic/humanoid3d_walk.txt"};
+  double fps = 30.0;  // frame rate of the 2D sequences
+  // A looping motion (DeepMimic's walk cycle) is repeated to at least this
+  // long, so that the prior sees cycles follow each other.
+  double loop_to_s = 20.0;
+  GenViewOptions views;
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("motions", self.motions, Range::Any(),
+      "3D motions (DeepMimic .txt or CMU .bvh)");
+    v("fps", self.fps, Range::Closed(1, 240), "frame rate of the 2D (Hz)");
+    v("loop_to_s", self.loop_to_s, Range::Closed(0, 3600),
+      "looping motions are repeated to at least this long (s)");
+    v("num_azimuths", self.views.num_azimuths, Range::Closed(1, 360),
+      "views per elevation, spread over 360 degrees");
+    v("elevations_deg", self.views.elevations_deg, Range::Open(-80, 80),
+      "camera elevations (deg)");
+    v("distance_m", self.views.distance_m, Range::Above(0.1),
+      "camera to subject (m)");
+    v("focal_px", self.views.focal_px, Range::Above(0), "focal length (px)");
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// The tokenizer: a 1D-convolutional VQ-VAE over X^can (T2M-GPT's design at
+// the paper's sizes: codebook 512 x 128).
+struct VqVaeOptions {
+  int num_codes = 512;          // K, the paper's codebook size
+  int code_size = 128;          // D, the paper's embedding size
+  int width = 128;              // channels of the convolutions
+  int down_levels = 2;          // each halves time: 2^levels frames per token
+  int residual_depth = 3;       // residual blocks per level (dilations 9, 3, 1)
+  double ema_decay = 0.99;      // codebook moving average
+  double commit_weight = 0.02;  // beta on |z - sg(q)|^2
+  double absolute_weight = 1.0;  // omega on |G^-1(X) - G^-1(X^)| (paper)
+  double velocity_weight = 0.5;  // on frame differences of the local pose
+  int window_frames = 64;        // training windows (multiple of 2^levels)
+  int batch_size = 64;
+  double learning_rate = 2e-4;  // AdamW
+  int64_t steps = 20000;        // gradient steps
+
+  int frames_per_token() const { return 1 << down_levels; }
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("num_codes", self.num_codes, Range::Closed(2, 65536), "codebook size K");
+    v("code_size", self.code_size, Range::Closed(1, 4096),
+      "code embedding size D");
+    v("width", self.width, Range::Closed(1, 4096), "convolution channels");
+    v("down_levels", self.down_levels, Range::Closed(0, 6),
+      "time halvings: 2^levels frames per token");
+    v("residual_depth", self.residual_depth, Range::Closed(0, 8),
+      "dilated residual blocks per level");
+    v("ema_decay", self.ema_decay, Range::Open(0, 1),
+      "codebook moving-average decay");
+    v("commit_weight", self.commit_weight, Range::AtLeast(0),
+      "commitment loss weight (beta)");
+    v("absolute_weight", self.absolute_weight, Range::AtLeast(0),
+      "weight of the absolute-coordinate loss (omega)");
+    v("velocity_weight", self.velocity_weight, Range::AtLeast(0),
+      "weight of the local-pose velocity loss");
+    v("window_frames", self.window_frames, Range::Closed(1, 100000),
+      "frames per training window");
+    v("batch_size", self.batch_size, Range::Closed(1, 100000),
+      "windows per gradient step");
+    v("learning_rate", self.learning_rate, Range::Above(0), "AdamW rate");
+    v("steps", self.steps, Range::Closed(0, 1e9), "gradient steps");
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// The prior: a GPT-style causal transformer over the tokens (the paper's 4
+// layers, 4 heads, embedding 128).
+struct GptOptions {
+  int num_layers = 4;
+  int num_heads = 4;
+  int embedding = 128;
+  int context_tokens = 32;  // attention window (tokens); also the sliding
+                            // context of endless generation
+  double dropout = 0.1;
+  // Each input token is replaced by a random code with probability
+  // 1 - keep (T2M-GPT's corruption), so that sampling recovers from its own
+  // unlikely draws.
+  double keep_probability = 0.9;
+  int batch_size = 64;
+  double learning_rate = 2e-4;  // AdamW
+  int64_t steps = 20000;
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("num_layers", self.num_layers, Range::Closed(1, 64),
+      "transformer blocks");
+    v("num_heads", self.num_heads, Range::Closed(1, 64), "attention heads");
+    v("embedding", self.embedding, Range::Closed(1, 4096),
+      "token embedding size (a multiple of num_heads)");
+    v("context_tokens", self.context_tokens, Range::Closed(2, 4096),
+      "attention window in tokens");
+    v("dropout", self.dropout, Range::Closed(0, 0.9), "dropout rate");
+    v("keep_probability", self.keep_probability, Range::Closed(0, 1),
+      "input tokens kept (others replaced by random codes)");
+    v("batch_size", self.batch_size, Range::Closed(1, 100000),
+      "token windows per gradient step");
+    v("learning_rate", self.learning_rate, Range::Above(0), "AdamW rate");
+    v("steps", self.steps, Range::Closed(0, 1e9), "gradient steps");
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// How codes are drawn from the prior.
+struct SamplingOptions {
+  double temperature = 1.0;  // > 0; lower is greedier
+  int top_k = 0;             // sample among the k likeliest codes (0: all)
+};
+
+// Where and how a run goes.
+struct GenRunOptions {
+  std::string run_dir = "runs/gen";  // tokenizer.pt, prior.pt, logs
+  uint64_t seed = 1;
+  double checkpoint_minutes = 5.0;
+  int torch_threads = 2;
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("run_dir", self.run_dir, Range::Any(),
+      "checkpoints and logs (relative to the working directory)");
+    v("seed", self.seed, Range::Any(), "seed of initialization and batches");
+    v("checkpoint_minutes", self.checkpoint_minutes, Range::Above(0),
+      "minutes between checkpoints");
+    v("torch_threads", self.torch_threads, Range::Closed(1, 256),
+      "LibTorch threads");
+  }
+};
+
+struct GenConfig {
+  std::string source_path;  // the YAML file
+  GenDataOptions data;
+  VqVaeOptions tokenizer;
+  GptOptions prior;
+  GenRunOptions run;
+
+  void Validate() const;  // throws ConfigError naming the setting
+};
+
+// Reads a config; InputError naming the file and key for unknown keys,
+// wrong types, out-of-range values.
+GenConfig LoadGenConfig(const std::string& yaml_path);
+// Every setting written out (what a checkpoint embeds) and read back.
+std::string GenConfigToYaml(const GenConfig& config);
+GenConfig LoadGenConfigText(const std::string& yaml_text,
+                            const std::string& source);
+// The reference table of every setting (Markdown).
+std::string GenSettingsReference();
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_GEN_GEN_CONFIG_H_

@@ -1,0 +1,132 @@
+#include "gen/generator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "common/error.h"
+#include "eval/metrics.h"
+#include "gen/feature_encoder.h"
+#include "gen/gen_checkpoint.h"
+#include "gen/gen_trainer.h"
+#include "gen/motion_stream.h"
+
+namespace m2d {
+
+GenConfig ReadGeneratorConfig(const std::string& run_dir) {
+  return LoadTokenizer(
+             (std::filesystem::path(run_dir) / kTokenizerFile).string())
+      .config;
+}
+
+GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
+                               const SamplingOptions& sampling, uint64_t seed) {
+  if (!(sampling.temperature > 0) || sampling.top_k < 0)
+    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
+  if (!(seconds > 0 && seconds <= 24 * 3600))
+    throw ConfigError("generation length must be in (0, 86400] s");
+  const std::filesystem::path run(run_dir);
+  LoadedTokenizer tokenizer = LoadTokenizer((run / kTokenizerFile).string());
+  LoadedPrior prior = LoadPrior((run / kPriorFile).string());
+  GeneratedMotion motion;
+  motion.fps = tokenizer.config.data.fps;
+  MotionStreamOptions options;
+  options.sampling = sampling;
+  options.seed = seed;
+  MotionStream stream(tokenizer, prior, options);
+  const int frame_size = stream.frame_size();
+  motion.num_frames = static_cast<int>(std::ceil(seconds * motion.fps));
+  const auto start = std::chrono::steady_clock::now();
+  while (static_cast<int>(motion.rows.size()) < motion.num_frames * frame_size)
+    stream.Next(&motion.rows);
+  motion.generation_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  motion.rows.resize(static_cast<size_t>(motion.num_frames) * frame_size);
+  motion.num_codes = static_cast<int>(stream.codes().size());
+  return motion;
+}
+
+std::string GeneratorEvalResult::BriefReport() const {
+  std::ostringstream out;
+  out.precision(4);
+  out << "FID generated vs real " << fid
+      << " (floor, real vs real: " << fid_floor << ", ratio "
+      << (fid_floor > 0 ? fid / fid_floor : 0.0) << ")\n"
+      << "diversity real " << diversity_real << ", generated "
+      << diversity_generated << "\n"
+      << "windows: real " << real_windows << ", held apart "
+      << held_apart_windows << " (encoder loss " << encoder_loss
+      << "), generated " << generated_windows << "\n"
+      << "generation speed " << realtime_factor
+      << "x real time (1 thread, tokens + decoding)\n";
+  return out.str();
+}
+
+GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
+                                      const GenDataset& real,
+                                      const GenDataset& held_apart,
+                                      const GeneratorEvalOptions& options) {
+  const std::filesystem::path run(run_dir);
+  const LoadedTokenizer tokenizer =
+      LoadTokenizer((run / kTokenizerFile).string());
+  const int frame_size = real.frame_size;
+  auto windows_of = [&](const std::vector<GenSequence>& sequences) {
+    return DatasetWindows(sequences, frame_size, options.window_frames,
+                          options.stride_frames, tokenizer.mean, tokenizer.std);
+  };
+  GeneratorEvalResult result;
+
+  // 1. The encoder, trained on motion the generator never saw.
+  const torch::Tensor held_windows = windows_of(held_apart.sequences);
+  result.held_apart_windows = static_cast<int>(held_windows.size(0));
+  FeatureEncoderOptions encoder_options;
+  encoder_options.window_frames = options.window_frames;
+  encoder_options.steps = options.encoder_steps;
+  FeatureEncoder encoder =
+      TrainFeatureEncoder(held_windows, frame_size, encoder_options,
+                          options.seed, &result.encoder_loss);
+
+  // 2. Real features, and the floor: two halves of the real sequences.
+  const torch::Tensor real_windows = windows_of(real.sequences);
+  result.real_windows = static_cast<int>(real_windows.size(0));
+  const Eigen::MatrixXd real_features = EncodeWindows(encoder, real_windows);
+  std::vector<GenSequence> half[2];
+  for (size_t i = 0; i < real.sequences.size(); ++i)
+    half[i % 2].push_back(real.sequences[i]);
+  result.fid_floor = FrechetDistance(
+      FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[0]))),
+      FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[1]))));
+
+  // 3. Generated features; generation timed on one thread.
+  const int threads = torch::get_num_threads();
+  torch::set_num_threads(1);
+  std::vector<GenSequence> generated;
+  double generation_s = 0.0, generated_s = 0.0;
+  for (int g = 0; g < options.generations; ++g) {
+    GeneratedMotion motion =
+        GenerateMotion(run_dir, options.seconds, options.sampling, g + 1);
+    generation_s += motion.generation_s;
+    generated_s += motion.num_frames / motion.fps;
+    generated.push_back({"generated/" + std::to_string(g + 1),
+                         motion.num_frames, std::move(motion.rows)});
+  }
+  torch::set_num_threads(threads);
+  result.realtime_factor = generated_s / std::max(1e-9, generation_s);
+  const torch::Tensor generated_windows = windows_of(generated);
+  result.generated_windows = static_cast<int>(generated_windows.size(0));
+  const Eigen::MatrixXd generated_features =
+      EncodeWindows(encoder, generated_windows);
+
+  // 4. The figures.
+  result.fid = FrechetDistance(FitFeatureGaussian(generated_features),
+                               FitFeatureGaussian(real_features));
+  result.diversity_real = MeanPairDistance(real_features, 300, options.seed);
+  result.diversity_generated =
+      MeanPairDistance(generated_features, 300, options.seed);
+  return result;
+}
+
+}  // namespace m2d

@@ -1,0 +1,69 @@
+// gen: using a trained generator — generating X^can, and measuring it: FID
+// of generated against real 2D motion in the features of an encoder
+// trained on held-apart motion, the real-against-real floor, diversity and
+// speed. This header does not include LibTorch.
+#ifndef MIMIC2D_GEN_GENERATOR_H_
+#define MIMIC2D_GEN_GENERATOR_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gen/gen_config.h"
+#include "gen/motion_dataset.h"
+
+namespace m2d {
+
+// The config a generator run was trained with (embedded in its
+// tokenizer.pt). InputError naming the file when it cannot be read.
+GenConfig ReadGeneratorConfig(const std::string& run_dir);
+
+struct GeneratedMotion {
+  std::vector<float> rows;  // num_frames rows of X^can (CanonicalFeatures)
+  int num_frames = 0;
+  double fps = 30.0;
+  int num_codes = 0;          // codes drawn from the prior
+  double generation_s = 0.0;  // wall time of the generation itself
+};
+
+// `seconds` of motion streamed from the run's prior and tokenizer
+// (gen/motion_stream.h), with `sampling` and `seed`.
+GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
+                               const SamplingOptions& sampling, uint64_t seed);
+
+struct GeneratorEvalOptions {
+  int generations = 10;   // independent streams (seeds 1..N)
+  double seconds = 60.0;  // per generation
+  SamplingOptions sampling;
+  int window_frames = 64;  // feature windows
+  int stride_frames = 16;
+  int64_t encoder_steps = 3000;
+  uint64_t seed = 1;  // encoder initialization and batches
+};
+
+struct GeneratorEvalResult {
+  int real_windows = 0, held_apart_windows = 0, generated_windows = 0;
+  double encoder_loss = 0.0;    // reconstruction MSE at the end
+  double fid = 0.0;             // generated vs real
+  double fid_floor = 0.0;       // real vs real: two halves of the sequences
+  double diversity_real = 0.0;  // mean feature distance of random pairs
+  double diversity_generated = 0.0;
+  double realtime_factor = 0.0;  // generated seconds per second of CPU
+                                 // time, one LibTorch thread
+  std::string BriefReport() const;
+};
+
+// Outline: the real windows (the generator's own dataset, rebuilt from its
+// config) and the held-apart windows (`held_apart`: motions it never saw)
+// in the tokenizer's normalization; an encoder trained on the held-apart
+// windows; features of the real windows, of two halves of them (by
+// sequence, alternating) and of `generations` generated streams; FIDs and
+// diversities. `run_dir` holds tokenizer.pt and prior.pt.
+GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
+                                      const GenDataset& real,
+                                      const GenDataset& held_apart,
+                                      const GeneratorEvalOptions& options);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_GEN_GENERATOR_H_

@@ -1,0 +1,171 @@
+#include "gen/gpt.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace m2d {
+namespace F = torch::nn::functional;
+
+CausalBlockImpl::CausalBlockImpl(int embedding, int num_heads, double dropout) {
+  attention_norm_ = register_module(
+      "attention_norm",
+      torch::nn::LayerNorm(torch::nn::LayerNormOptions({embedding})));
+  attention_ = register_module(
+      "attention",
+      torch::nn::MultiheadAttention(
+          torch::nn::MultiheadAttentionOptions(embedding, num_heads)
+              .dropout(dropout)));
+  mlp_norm_ = register_module(
+      "mlp_norm",
+      torch::nn::LayerNorm(torch::nn::LayerNormOptions({embedding})));
+  mlp_in_ =
+      register_module("mlp_in", torch::nn::Linear(embedding, 4 * embedding));
+  mlp_out_ =
+      register_module("mlp_out", torch::nn::Linear(4 * embedding, embedding));
+  dropout_ = register_module("dropout", torch::nn::Dropout(dropout));
+}
+
+torch::Tensor CausalBlockImpl::forward(const torch::Tensor& x,
+                                       const torch::Tensor& mask) {
+  torch::Tensor h = attention_norm_->forward(x);
+  torch::Tensor attended =
+      std::get<0>(attention_->forward(h, h, h, /*key_padding_mask=*/{},
+                                      /*need_weights=*/false, mask));
+  torch::Tensor y = x + dropout_->forward(attended);
+  torch::Tensor m = F::gelu(mlp_in_->forward(mlp_norm_->forward(y)));
+  return y + dropout_->forward(mlp_out_->forward(m));
+}
+
+GptImpl::GptImpl(int num_codes, const GptOptions& options)
+    : num_codes_(num_codes), options_(options) {
+  const int embedding = options.embedding;
+  token_embedding_ = register_module(
+      "token_embedding", torch::nn::Embedding(num_codes + 1, embedding));
+  position_embedding_ = register_parameter(
+      "position_embedding", torch::zeros({options.context_tokens, embedding}));
+  for (int i = 0; i < options.num_layers; ++i) {
+    blocks_.push_back(register_module(
+        "block" + std::to_string(i),
+        CausalBlock(embedding, options.num_heads, options.dropout)));
+  }
+  final_norm_ = register_module(
+      "final_norm",
+      torch::nn::LayerNorm(torch::nn::LayerNormOptions({embedding})));
+  head_ = register_module(
+      "head", torch::nn::Linear(
+                  torch::nn::LinearOptions(embedding, num_codes).bias(false)));
+  dropout_ = register_module("dropout", torch::nn::Dropout(options.dropout));
+  // GPT-2's initialization: N(0, 0.02) weights, zero biases.
+  torch::NoGradGuard no_grad;
+  for (auto& parameter : named_parameters()) {
+    const std::string& name = parameter.key();
+    if (name.find("norm") != std::string::npos) continue;
+    if (name.size() >= 4 && name.compare(name.size() - 4, 4, "bias") == 0) {
+      parameter.value().zero_();
+    } else {
+      parameter.value().normal_(0.0, 0.02);
+    }
+  }
+}
+
+torch::Tensor GptImpl::forward(const torch::Tensor& tokens) {
+  const int64_t length = tokens.size(1);
+  TORCH_CHECK(length <= options_.context_tokens, "GPT input of ", length,
+              " tokens exceeds the context of ", options_.context_tokens);
+  torch::Tensor x = token_embedding_->forward(tokens) +
+                    position_embedding_.narrow(0, 0, length).unsqueeze(0);
+  x = dropout_->forward(x).transpose(0, 1);  // [S, B, E]
+  torch::Tensor mask =
+      torch::full({length, length}, -std::numeric_limits<float>::infinity())
+          .triu(1);
+  for (CausalBlock& block : blocks_) x = block->forward(x, mask);
+  return head_->forward(final_norm_->forward(x.transpose(0, 1)));
+}
+
+TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
+                            int num_codes, int context, int batch_size,
+                            double keep_probability,
+                            torch::Generator& generator) {
+  TORCH_CHECK(!sequences.empty(), "no token sequences to sample from");
+  const int64_t start = num_codes;
+  torch::Tensor inputs = torch::zeros({batch_size, context}, torch::kLong);
+  torch::Tensor targets =
+      torch::full({batch_size, context}, kIgnoreTarget, torch::kLong);
+  auto draw = [&](int64_t bound) {  // uniform in [0, bound)
+    return torch::randint(bound, {1}, generator, torch::kLong).item<int64_t>();
+  };
+  for (int b = 0; b < batch_size; ++b) {
+    const std::vector<int64_t>& codes =
+        sequences[draw(static_cast<int64_t>(sequences.size()))];
+    // The read sequence [start, c_0, ..., c_{n-1}] has n + 1 tokens; a
+    // window of `context` inputs predicts the token after each of them.
+    const int64_t read_length = static_cast<int64_t>(codes.size()) + 1;
+    const int64_t offset = draw(std::max<int64_t>(1, read_length - context));
+    auto token_at = [&](int64_t i) { return i == 0 ? start : codes[i - 1]; };
+    int64_t* input = inputs[b].data_ptr<int64_t>();
+    int64_t* target = targets[b].data_ptr<int64_t>();
+    for (int64_t s = 0; s < context && offset + s + 1 < read_length; ++s) {
+      input[s] = token_at(offset + s);
+      target[s] = token_at(offset + s + 1);
+    }
+  }
+  if (keep_probability < 1.0) {
+    torch::Tensor corrupt =
+        torch::rand({batch_size, context}, generator) >= keep_probability;
+    corrupt = corrupt.logical_and(inputs != start);
+    inputs = torch::where(corrupt,
+                          torch::randint(num_codes, {batch_size, context},
+                                         generator, torch::kLong),
+                          inputs);
+  }
+  return {inputs, targets};
+}
+
+torch::Tensor NextTokenLoss(const torch::Tensor& logits,
+                            const torch::Tensor& targets) {
+  return F::cross_entropy(
+      logits.reshape({-1, logits.size(2)}), targets.reshape({-1}),
+      F::CrossEntropyFuncOptions().ignore_index(kIgnoreTarget));
+}
+
+TokenSampler::TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed)
+    : gpt_(std::move(gpt)),
+      options_(options),
+      generator_(at::make_generator<at::CPUGeneratorImpl>(seed)) {
+  TORCH_CHECK(options_.temperature > 0, "sampling temperature must be > 0");
+  history_.push_back(gpt_->start_token());
+}
+
+int64_t TokenSampler::Next() {
+  torch::NoGradGuard no_grad;
+  gpt_->eval();
+  const int64_t length = std::min<int64_t>(
+      static_cast<int64_t>(history_.size()), gpt_->context_tokens());
+  torch::Tensor window =
+      torch::tensor(
+          std::vector<int64_t>(history_.end() - length, history_.end()),
+          torch::kLong)
+          .unsqueeze(0);
+  torch::Tensor logits =
+      gpt_->forward(window).select(1, length - 1).squeeze(0) /
+      options_.temperature;
+  if (options_.top_k > 0 && options_.top_k < logits.size(0)) {
+    const float threshold =
+        std::get<0>(logits.topk(options_.top_k)).min().item<float>();
+    logits = logits.masked_fill(logits < threshold,
+                                -std::numeric_limits<float>::infinity());
+  }
+  const int64_t code =
+      torch::multinomial(torch::softmax(logits, 0), 1, false, generator_)
+          .item<int64_t>();
+  history_.push_back(code);
+  // The history only needs the attended window.
+  if (history_.size() > static_cast<size_t>(4 * gpt_->context_tokens()))
+    history_.erase(history_.begin(), history_.end() - gpt_->context_tokens());
+  codes_.push_back(code);
+  return code;
+}
+
+}  // namespace m2d

@@ -1,0 +1,96 @@
+// gen: the prior — a GPT-style causal transformer over the tokenizer's
+// codes, p(c) = Π p(c_i | c_<i), sampled with temperature and top-k from a
+// sliding context so that generation never ends.
+#ifndef MIMIC2D_GEN_GPT_H_
+#define MIMIC2D_GEN_GPT_H_
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "gen/gen_config.h"
+
+namespace m2d {
+
+// Pre-LN block: x + attention(LN(x)), then x + MLP(LN(x)) (GELU, 4x wide).
+// LibTorch 1.13's TransformerEncoderLayer is post-LN only.
+class CausalBlockImpl : public torch::nn::Module {
+ public:
+  CausalBlockImpl(int embedding, int num_heads, double dropout);
+  // x: [S, B, E]; mask: [S, S] additive (-inf above the diagonal).
+  torch::Tensor forward(const torch::Tensor& x, const torch::Tensor& mask);
+
+ private:
+  torch::nn::LayerNorm attention_norm_{nullptr}, mlp_norm_{nullptr};
+  torch::nn::MultiheadAttention attention_{nullptr};
+  torch::nn::Linear mlp_in_{nullptr}, mlp_out_{nullptr};
+  torch::nn::Dropout dropout_{nullptr};
+};
+TORCH_MODULE(CausalBlock);
+
+class GptImpl : public torch::nn::Module {
+ public:
+  // Vocabulary: the K codes and a start token (K) that opens a sequence.
+  GptImpl(int num_codes, const GptOptions& options);
+
+  // tokens: [B, S] int64 in [0, K], S <= context_tokens -> logits over the
+  // K codes [B, S, K] for each next token.
+  torch::Tensor forward(const torch::Tensor& tokens);
+
+  int num_codes() const { return num_codes_; }
+  int64_t start_token() const { return num_codes_; }
+  int context_tokens() const { return options_.context_tokens; }
+
+ private:
+  int num_codes_;
+  GptOptions options_;
+  torch::nn::Embedding token_embedding_{nullptr};
+  torch::Tensor position_embedding_;  // [context, E], learned
+  std::vector<CausalBlock> blocks_;
+  torch::nn::LayerNorm final_norm_{nullptr};
+  torch::nn::Linear head_{nullptr};
+  torch::nn::Dropout dropout_{nullptr};
+};
+TORCH_MODULE(Gpt);
+
+// A training batch of token windows: inputs [B, S] and targets [B, S] (the
+// next token; kIgnoreTarget where a short sequence ends).
+inline constexpr int64_t kIgnoreTarget = -100;
+struct TokenBatch {
+  torch::Tensor inputs, targets;
+};
+
+// Draws `batch_size` windows of `context` tokens. Each sequence is read as
+// [start, c_0, ..., c_{n-1}]; a window starts anywhere in it (so windows
+// without the start token teach the sliding context of endless generation)
+// and is padded when the sequence is shorter. With probability 1 −
+// keep_probability an input code is replaced by a random code.
+TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
+                            int num_codes, int context, int batch_size,
+                            double keep_probability,
+                            torch::Generator& generator);
+
+// Mean next-token cross-entropy (nats) of a batch.
+torch::Tensor NextTokenLoss(const torch::Tensor& logits,
+                            const torch::Tensor& targets);
+
+// Endless sampling: the history starts with the start token; each step
+// attends to the last context_tokens tokens of it.
+class TokenSampler {
+ public:
+  TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed);
+  int64_t Next();  // draws, appends and returns the next code
+  const std::vector<int64_t>& codes() const { return codes_; }
+
+ private:
+  Gpt gpt_;
+  SamplingOptions options_;
+  torch::Generator generator_;
+  std::vector<int64_t> history_;  // start token, then the codes
+  std::vector<int64_t> codes_;
+};
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_GEN_GPT_H_

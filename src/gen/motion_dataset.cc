@@ -1,0 +1,175 @@
+#include "gen/motion_dataset.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/error.h"
+#include "motion/bundle.h"
+
+namespace m2d {
+
+int CanonicalFrameSize(const KeypointLayout& layout) {
+  return 2 * layout.num_keypoints() + 3;
+}
+
+std::vector<float> CanonicalFeatures(const CanonicalClip& canonical) {
+  const int num_frames = canonical.num_frames();
+  const int num_keypoints = canonical.local_pose.num_keypoints();
+  const int frame_size = 2 * num_keypoints + 3;
+  std::vector<float> rows(static_cast<size_t>(num_frames) * frame_size);
+  // Outline: per keypoint, its first present value seeds the frames before
+  // it; afterwards each missing frame holds the last present value.
+  for (int j = 0; j < num_keypoints; ++j) {
+    float held_x = 0.0f, held_y = 0.0f;
+    for (int t = 0; t < num_frames; ++t) {
+      const Keypoint2D& point = canonical.local_pose.at(t, j);
+      if (point.IsPresent()) {
+        held_x = static_cast<float>(point.x_px);
+        held_y = static_cast<float>(point.y_px);
+        break;
+      }
+    }
+    for (int t = 0; t < num_frames; ++t) {
+      const Keypoint2D& point = canonical.local_pose.at(t, j);
+      if (point.IsPresent()) {
+        held_x = static_cast<float>(point.x_px);
+        held_y = static_cast<float>(point.y_px);
+      }
+      float* row = rows.data() + static_cast<size_t>(t) * frame_size;
+      row[2 * j] = held_x;
+      row[2 * j + 1] = held_y;
+    }
+  }
+  for (int t = 0; t < num_frames; ++t) {
+    float* row = rows.data() + static_cast<size_t>(t) * frame_size;
+    row[2 * num_keypoints] = static_cast<float>(canonical.delta_root[t].x());
+    row[2 * num_keypoints + 1] =
+        static_cast<float>(canonical.delta_root[t].y());
+    row[2 * num_keypoints + 2] =
+        static_cast<float>(canonical.delta_log_scale[t]);
+  }
+  return rows;
+}
+
+CanonicalClip CanonicalFromFeatures(const float* rows, int num_frames,
+                                    const KeypointLayout& layout, double fps,
+                                    Eigen::Vector2d first_root_px,
+                                    double first_scale_px) {
+  const int num_keypoints = layout.num_keypoints();
+  const int frame_size = CanonicalFrameSize(layout);
+  CanonicalClip canonical;
+  canonical.layout = &layout;
+  canonical.fps = fps;
+  canonical.local_pose = KeypointTrack(num_frames, num_keypoints);
+  canonical.delta_root.resize(num_frames);
+  canonical.delta_log_scale.resize(num_frames);
+  for (int t = 0; t < num_frames; ++t) {
+    const float* row = rows + static_cast<size_t>(t) * frame_size;
+    for (int j = 0; j < num_keypoints; ++j)
+      canonical.local_pose.at(t, j) = {row[2 * j], row[2 * j + 1], 1.0};
+    canonical.delta_root[t] = {row[2 * num_keypoints],
+                               row[2 * num_keypoints + 1]};
+    canonical.delta_log_scale[t] = row[2 * num_keypoints + 2];
+  }
+  // FromCanonical applies deltas from the second frame on; fold the first
+  // row's into the placement.
+  canonical.first_scale_px =
+      first_scale_px * std::exp(canonical.delta_log_scale[0]);
+  canonical.first_root_px =
+      first_root_px + canonical.first_scale_px * canonical.delta_root[0];
+  canonical.delta_root[0].setZero();
+  canonical.delta_log_scale[0] = 0.0;
+  return canonical;
+}
+
+void GenViewOptions::Validate() const {
+  if (num_azimuths < 1 || num_azimuths > 360)
+    throw ConfigError("views: num_azimuths must be in [1, 360]");
+  if (elevations_deg.empty())
+    throw ConfigError("views: elevations_deg needs at least one elevation");
+  for (double elevation : elevations_deg) {
+    if (!(elevation > -80.0 && elevation < 80.0))
+      throw ConfigError("views: elevations_deg must lie in (-80, 80)");
+  }
+  RigOptions rig;
+  rig.distance_m = distance_m;
+  rig.focal_px = focal_px;
+  rig.width_px = width_px;
+  rig.height_px = height_px;
+  rig.Validate();
+}
+
+int64_t GenDataset::num_frames() const {
+  int64_t frames = 0;
+  for (const GenSequence& sequence : sequences) frames += sequence.num_frames;
+  return frames;
+}
+
+void FeatureStatistics(const std::vector<GenSequence>& sequences,
+                       int frame_size, std::vector<float>* mean,
+                       std::vector<float>* std) {
+  std::vector<double> sum(frame_size, 0.0), squares(frame_size, 0.0);
+  int64_t count = 0;
+  for (const GenSequence& sequence : sequences) {
+    for (int t = 0; t < sequence.num_frames; ++t) {
+      const float* row =
+          sequence.features.data() + static_cast<size_t>(t) * frame_size;
+      for (int c = 0; c < frame_size; ++c) {
+        sum[c] += row[c];
+        squares[c] += static_cast<double>(row[c]) * row[c];
+      }
+    }
+    count += sequence.num_frames;
+  }
+  mean->assign(frame_size, 0.0f);
+  std->assign(frame_size, 1.0f);
+  if (count == 0) return;
+  for (int c = 0; c < frame_size; ++c) {
+    const double m = sum[c] / count;
+    const double variance = std::max(0.0, squares[c] / count - m * m);
+    (*mean)[c] = static_cast<float>(m);
+    (*std)[c] =
+        std::max(kMinFeatureStd, static_cast<float>(std::sqrt(variance)));
+  }
+}
+
+GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
+                           const GenViewOptions& views, double fps,
+                           double loop_to_s) {
+  views.Validate();
+  GenDataset dataset;
+  dataset.fps = fps;
+  dataset.frame_size = CanonicalFrameSize(*dataset.layout);
+  for (const GenMotionSource& source : motions) {
+    for (double elevation : views.elevations_deg) {
+      BundleFromMotionOptions options;
+      options.fps = fps;
+      if (source.motion.loops)
+        options.duration_s = std::max(source.motion.duration_s(), loop_to_s);
+      options.follow = CameraFollow::kRootDolly;
+      options.rig.num_views = views.num_azimuths;
+      options.rig.elevation_deg = elevation;
+      options.rig.distance_m = views.distance_m;
+      options.rig.focal_px = views.focal_px;
+      options.rig.width_px = views.width_px;
+      options.rig.height_px = views.height_px;
+      const ReferenceBundle bundle = MakeBundleFromMotion(
+          source.motion, source.keypoint_map, options, source.name);
+      for (const ReferenceView& view : bundle.views) {
+        const CanonicalClip canonical = ToCanonical(view.clip, source.name);
+        GenSequence sequence;
+        sequence.name =
+            source.name + "/" + view.name + "_el" +
+            std::to_string(static_cast<int>(std::lround(elevation)));
+        sequence.num_frames = canonical.num_frames();
+        sequence.features = CanonicalFeatures(canonical);
+        dataset.sequences.push_back(std::move(sequence));
+      }
+    }
+  }
+  FeatureStatistics(dataset.sequences, dataset.frame_size, &dataset.mean,
+                    &dataset.std);
+  return dataset;
+}
+
+}  // namespace m2d

@@ -1,0 +1,100 @@
+// gen: generating 2D motion — the dataset of canonical 2D sequences, the
+// VQ-VAE tokenizer, the GPT prior over its tokens and streaming generation
+// (docs/generation.md). LibTorch is confined to the .cc files and to the
+// model headers (vqvae.h, gpt.h); this header does not include it.
+#ifndef MIMIC2D_GEN_MOTION_DATASET_H_
+#define MIMIC2D_GEN_MOTION_DATASET_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "camera/rig.h"
+#include "motion/canonical.h"
+#include "motion/motion3d.h"
+#include "motion/skeleton.h"
+
+namespace m2d {
+
+// One frame of X^can as numbers: x̄ (J × 2, x then y per keypoint), then
+// delta_root (2), then delta_log_scale (1).
+int CanonicalFrameSize(const KeypointLayout& layout);
+
+// Frame-major rows of X^can. A missing keypoint (its local coordinates are
+// NaN) repeats its last present value in the clip (its first present value
+// before that; 0 when it is never present): the networks need numbers
+// everywhere, and a held value is what a tracker would follow.
+std::vector<float> CanonicalFeatures(const CanonicalClip& canonical);
+
+// The inverse of CanonicalFeatures: `num_frames` rows of `rows` as a
+// CanonicalClip with every keypoint present (confidence 1), placed by
+// `first_root_px` / `first_scale_px` like ToCanonical's first frame (the
+// first row's deltas are applied on top of them, as FromCanonical does for
+// later frames; they are 0 for a clip's own first frame).
+CanonicalClip CanonicalFromFeatures(const float* rows, int num_frames,
+                                    const KeypointLayout& layout, double fps,
+                                    Eigen::Vector2d first_root_px,
+                                    double first_scale_px);
+
+// The views a 3D motion is seen from: every azimuth at every elevation, the
+// camera dollying with the subject so that long walks stay in frame. The
+// representation is 2D; views are data augmentation.
+struct GenViewOptions {
+  int num_azimuths = 8;                          // spread over 360°
+  std::vector<double> elevations_deg = {0, 20};  // camera elevations
+  double distance_m = 4.5;                       // camera to subject
+  double focal_px = 1000.0;
+  int width_px = 1920;
+  int height_px = 1080;
+
+  int num_views() const {
+    return num_azimuths * static_cast<int>(elevations_deg.size());
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// A named 3D motion with the keypoint map that places COCO-17 on it.
+struct GenMotionSource {
+  std::string name;
+  Motion3D motion;
+  KeypointMap keypoint_map;
+};
+
+// One sequence of the dataset: a motion seen from one view.
+struct GenSequence {
+  std::string name;  // "<motion>/<view>"
+  int num_frames = 0;
+  std::vector<float> features;  // num_frames rows of CanonicalFrameSize
+};
+
+struct GenDataset {
+  const KeypointLayout* layout = &Coco17Layout();
+  double fps = 30.0;
+  int frame_size = 0;
+  std::vector<GenSequence> sequences;
+  // Per-channel statistics over every frame, for normalization; std has a
+  // floor (kMinFeatureStd) so that a constant channel does not blow up.
+  std::vector<float> mean, std;
+
+  int64_t num_frames() const;
+};
+
+inline constexpr float kMinFeatureStd = 1e-3f;
+
+// Projects every motion into every view (motion/bundle.h's
+// MakeBundleFromMotion at `fps`; a looping motion repeated to at least
+// `loop_to_s`) and stores each view's canonical features; then the
+// normalization statistics. Throws InputError naming a motion whose
+// projection has no usable frame.
+GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
+                           const GenViewOptions& views, double fps,
+                           double loop_to_s);
+
+// Per-channel mean and std (floored) of every row of `sequences`.
+void FeatureStatistics(const std::vector<GenSequence>& sequences,
+                       int frame_size, std::vector<float>* mean,
+                       std::vector<float>* std);
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_GEN_MOTION_DATASET_H_

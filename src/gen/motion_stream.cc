@@ -1,0 +1,53 @@
+#include "gen/motion_stream.h"
+
+#include <algorithm>
+
+#include "common/error.h"
+
+namespace m2d {
+
+MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
+                           const MotionStreamOptions& options)
+    : tokenizer_(std::move(tokenizer)),
+      sampler_(prior.model, options.sampling, options.seed),
+      options_(options) {
+  if (prior.model->num_codes() != tokenizer_.model->num_codes()) {
+    throw ConfigError("the prior predicts " +
+                      std::to_string(prior.model->num_codes()) +
+                      " codes but the tokenizer has " +
+                      std::to_string(tokenizer_.model->num_codes()) +
+                      ": they come from different runs");
+  }
+  if (options_.decode_context_codes < 2)
+    throw ConfigError("decode_context_codes must be at least 2");
+  tokenizer_.model->eval();
+}
+
+void MotionStream::Next(std::vector<float>* rows) {
+  torch::NoGradGuard no_grad;
+  // Outline: draw codes until the one after the next code to emit exists;
+  // decode the latest codes; keep the frames of the code to emit.
+  while (static_cast<int64_t>(sampler_.codes().size()) < emitted_codes_ + 2)
+    sampler_.Next();
+  const std::vector<int64_t>& codes = sampler_.codes();
+  const int64_t end = emitted_codes_ + 2;  // codes [begin, end) are decoded
+  const int64_t begin =
+      std::max<int64_t>(0, end - options_.decode_context_codes);
+  torch::Tensor window =
+      torch::tensor(
+          std::vector<int64_t>(codes.begin() + begin, codes.begin() + end),
+          torch::kLong)
+          .unsqueeze(0);
+  torch::Tensor frames = tokenizer_.model->Decode(window)[0];  // [T, C]
+  const int per_token = frames_per_token();
+  torch::Tensor emitted =
+      (frames.narrow(0, (emitted_codes_ - begin) * per_token, per_token) *
+           tokenizer_.std +
+       tokenizer_.mean)
+          .contiguous();
+  rows->insert(rows->end(), emitted.data_ptr<float>(),
+               emitted.data_ptr<float>() + emitted.numel());
+  ++emitted_codes_;
+}
+
+}  // namespace m2d

@@ -1,0 +1,48 @@
+// gen: endless generation — the prior draws a code at a time and the
+// tokenizer's decoder turns the latest codes into frames of X^can, streamed
+// as they are made.
+#ifndef MIMIC2D_GEN_MOTION_STREAM_H_
+#define MIMIC2D_GEN_MOTION_STREAM_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "gen/gen_checkpoint.h"
+#include "gen/gpt.h"
+
+namespace m2d {
+
+struct MotionStreamOptions {
+  SamplingOptions sampling;
+  // Codes the decoder sees per step. Its receptive field spans a few codes;
+  // more costs time, fewer makes the seams between codes show.
+  int decode_context_codes = 8;
+  uint64_t seed = 1;
+};
+
+// Each Next() emits one code's frames. The frames of a code are decoded
+// when the code after it exists (one code of latency, 4 frames at 30 Hz),
+// so that the decoder never works at the window's open edge.
+class MotionStream {
+ public:
+  MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
+               const MotionStreamOptions& options);
+
+  // Appends frames_per_token() rows of X^can (not normalized; rows of
+  // CanonicalFeatures) to `rows`.
+  void Next(std::vector<float>* rows);
+
+  int frames_per_token() const { return tokenizer_.model->frames_per_token(); }
+  int frame_size() const { return tokenizer_.model->frame_size(); }
+  const std::vector<int64_t>& codes() const { return sampler_.codes(); }
+
+ private:
+  LoadedTokenizer tokenizer_;
+  TokenSampler sampler_;
+  MotionStreamOptions options_;
+  int64_t emitted_codes_ = 0;
+};
+
+}  // namespace m2d
+
+#endif  // MIMIC2D_GEN_MOTION_STREAM_H_

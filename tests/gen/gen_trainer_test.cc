@@ -1,0 +1,177 @@
+#include "gen/gen_trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "common/file_io.h"
+#include "gen/gen_checkpoint.h"
+#include "gen/gen_test_data.h"
+#include "gen/generator.h"
+#include "gen/motion_stream.h"
+
+namespace m2d {
+namespace {
+
+GenDataset WalkDataset() { return testing::ClipDataset("walk", 2, {10}, 4.0); }
+
+GenConfig TinyConfig(const std::string& run_dir) {
+  GenConfig config;
+  config.tokenizer.num_codes = 16;
+  config.tokenizer.code_size = 16;
+  config.tokenizer.width = 32;
+  config.tokenizer.residual_depth = 1;
+  config.tokenizer.window_frames = 16;
+  config.tokenizer.batch_size = 4;
+  config.tokenizer.steps = 6;
+  config.prior.num_layers = 1;
+  config.prior.num_heads = 2;
+  config.prior.embedding = 16;
+  config.prior.context_tokens = 8;
+  config.prior.batch_size = 4;
+  config.prior.steps = 4;
+  config.run.run_dir = run_dir;
+  config.run.torch_threads = 1;
+  config.Validate();
+  return config;
+}
+
+std::string TempRun(const std::string& name) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("m2d_gen_" + name)).string();
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+TEST(GenTrainer, AResumedRunEndsWhereAnUninterruptedOneDoes) {
+  const GenDataset dataset = WalkDataset();
+  // Straight through.
+  const GenConfig straight = TinyConfig(TempRun("straight"));
+  TrainGenerator(straight, dataset, false, nullptr, nullptr);
+  // Stopped after the first tokenizer step, then resumed.
+  const GenConfig stopped = TinyConfig(TempRun("resumed"));
+  std::atomic<bool> stop{false};
+  GenTrainSummary first = TrainGenerator(
+      stopped, dataset, false, &stop, [&](const GenProgress&) { stop = true; });
+  EXPECT_TRUE(first.interrupted);
+  EXPECT_EQ(first.tokenizer_steps, 1);
+  GenTrainSummary second =
+      TrainGenerator(stopped, dataset, true, nullptr, nullptr);
+  EXPECT_FALSE(second.interrupted);
+  EXPECT_EQ(second.tokenizer_steps, 6);
+  EXPECT_EQ(second.prior_steps, 4);
+
+  LoadedTokenizer a = LoadTokenizer(straight.run.run_dir + "/tokenizer.pt");
+  LoadedTokenizer b = LoadTokenizer(stopped.run.run_dir + "/tokenizer.pt");
+  auto pa = a.model->named_parameters(), pb = b.model->named_parameters();
+  for (const auto& item : pa)
+    EXPECT_TRUE(torch::equal(item.value(), pb[item.key()])) << item.key();
+  auto ba = a.model->named_buffers(), bb = b.model->named_buffers();
+  for (const auto& item : ba)
+    EXPECT_TRUE(torch::equal(item.value(), bb[item.key()])) << item.key();
+  // The log: one row per reported step, none twice.
+  const std::string log =
+      ReadFileText(stopped.run.run_dir + "/tokenizer_log.csv");
+  EXPECT_EQ(log.find("\n1,"), log.rfind("\n1,"));
+  EXPECT_NE(log.find("\n6,"), std::string::npos);
+}
+
+TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
+  const GenDataset dataset = WalkDataset();
+  const GenConfig config = TinyConfig(TempRun("stream"));
+  TrainGenerator(config, dataset, false, nullptr, nullptr);
+  MotionStreamOptions options;
+  options.seed = 3;
+  MotionStream stream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                      LoadPrior(config.run.run_dir + "/prior.pt"), options);
+  std::vector<float> rows;
+  for (int i = 0; i < 20; ++i) stream.Next(&rows);  // past the context
+  EXPECT_EQ(rows.size(), 20u * 4 * 37);
+  for (float value : rows) ASSERT_TRUE(std::isfinite(value));
+  EXPECT_GE(stream.codes().size(), 21u);
+}
+
+TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
+  // The FID protocol's plumbing on a tiny run: every count and figure is
+  // there and finite (FeatureEncoder's test checks what FID separates).
+  const GenDataset walk = WalkDataset();
+  const GenConfig config = TinyConfig(TempRun("measured"));
+  TrainGenerator(config, walk, false, nullptr, nullptr);
+  GeneratorEvalOptions options;
+  options.generations = 2;
+  options.seconds = 3.0;
+  options.window_frames = 16;
+  options.stride_frames = 8;
+  options.encoder_steps = 20;
+  const GeneratorEvalResult result =
+      EvaluateGenerator(config.run.run_dir, walk, walk, options);
+  EXPECT_EQ(result.generated_windows, 2 * ((90 - 16) / 8 + 1));
+  EXPECT_GT(result.real_windows, 0);
+  EXPECT_GE(result.fid, 0.0);
+  EXPECT_GE(result.fid_floor, 0.0);
+  EXPECT_GT(result.diversity_generated, 0.0);
+  EXPECT_GT(result.realtime_factor, 1.0);
+  EXPECT_TRUE(std::isfinite(result.fid));
+  // What a user gets from `generate`: the frames asked for, finite.
+  const GeneratedMotion motion =
+      GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.8, 5}, 4);
+  EXPECT_EQ(motion.num_frames, 60);
+  EXPECT_EQ(motion.rows.size(), 60u * 37);
+  EXPECT_THROW(
+      GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.0, 0}, 4),
+      ConfigError);
+}
+
+TEST(GenTrainer, ADamagedCheckpointIsNamed) {
+  const std::string dir = TempRun("damaged");
+  std::filesystem::create_directories(dir);
+  WriteFileAtomic(dir + "/tokenizer.pt", "not an archive");
+  try {
+    LoadTokenizer(dir + "/tokenizer.pt");
+    FAIL() << "loaded a damaged checkpoint";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tokenizer.pt"), std::string::npos);
+  }
+  // A tracking checkpoint is not a tokenizer.
+  const GenConfig config = TinyConfig(TempRun("other"));
+  EXPECT_THROW(LoadPrior(dir + "/tokenizer.pt"), InputError);
+}
+
+TEST(GenConfig, ReadsBackWhatItWrites) {
+  GenConfig config = TinyConfig("runs/x");
+  const GenConfig back = LoadGenConfigText(GenConfigToYaml(config), "test");
+  EXPECT_EQ(GenConfigToYaml(back), GenConfigToYaml(config));
+  EXPECT_THROW(LoadGenConfigText("tokenizer: {num_codes: 1}\n", "bad.yaml"),
+               InputError);
+  EXPECT_THROW(
+      LoadGenConfigText("tokenizer: {window_frames: 30}\n", "bad.yaml"),
+      InputError);
+  EXPECT_THROW(
+      LoadGenConfigText("prior: {embedding: 30, num_heads: 4}\n", "bad.yaml"),
+      InputError);
+  EXPECT_THROW(LoadGenConfigText("prior: {unknown: 1}\n", "bad.yaml"),
+               InputError);
+}
+
+TEST(GenConfig, EveryShippedConfigLoadsAndTheDocsListEverySetting) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           testing::SourcePath("configs/gen"))) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(LoadGenConfig(entry.path().string()));
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 1);
+  // docs/generation.md carries the reference table (regenerate with
+  // `mimic2d gen train --list-settings`).
+  const std::string docs =
+      ReadFileText(testing::SourcePath("docs/generation.md"));
+  EXPECT_NE(docs.find(GenSettingsReference()), std::string::npos)
+      << "docs/generation.md's settings table is stale";
+}
+
+}  // namespace
+}  // namespace m2d

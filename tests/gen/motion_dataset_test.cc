@@ -1,0 +1,97 @@
+#include "gen/motion_dataset.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "common/error.h"
+#include "gen/gen_test_data.h"
+#include "motion/bundle.h"
+
+namespace m2d {
+namespace {
+
+GenMotionSource WalkSource() { return testing::DeepMimicSource("walk"); }
+
+TEST(GenDataset, FeaturesReadBackToTheSameClip) {
+  // One follow-camera view of the walk, 3 s (the cycle looped).
+  BundleFromMotionOptions options;
+  options.rig.num_views = 1;
+  options.duration_s = 3.0;
+  options.follow = CameraFollow::kRootDolly;
+  const GenMotionSource walk = WalkSource();
+  const Clip2D clip =
+      MakeBundleFromMotion(walk.motion, walk.keypoint_map, options, "walk")
+          .views[0]
+          .clip;
+  const CanonicalClip canonical = ToCanonical(clip);
+  const std::vector<float> rows = CanonicalFeatures(canonical);
+  ASSERT_EQ(rows.size(), static_cast<size_t>(clip.num_frames()) *
+                             CanonicalFrameSize(*clip.layout));
+  const Clip2D back = FromCanonical(CanonicalFromFeatures(
+      rows.data(), clip.num_frames(), *clip.layout, clip.fps,
+      canonical.first_root_px, canonical.first_scale_px));
+  ASSERT_EQ(back.num_frames(), clip.num_frames());
+  double worst_px = 0.0;
+  for (int t = 0; t < clip.num_frames(); ++t) {
+    for (int j = 0; j < clip.keypoints.num_keypoints(); ++j) {
+      worst_px = std::max(worst_px, (back.keypoints.at(t, j).Pixel() -
+                                     clip.keypoints.at(t, j).Pixel())
+                                        .norm());
+    }
+  }
+  // float32 rows; the root is a running sum over 91 frames.
+  EXPECT_LT(worst_px, 0.01);
+}
+
+TEST(GenDataset, MissingKeypointsHoldTheirLastValue) {
+  CanonicalClip canonical;
+  canonical.local_pose = KeypointTrack(3, 17);
+  canonical.delta_root.assign(3, Eigen::Vector2d::Zero());
+  canonical.delta_log_scale.assign(3, 0.0);
+  for (int t = 0; t < 3; ++t)
+    for (int j = 0; j < 17; ++j)
+      canonical.local_pose.at(t, j) = {0.1 * t, static_cast<double>(j), 1};
+  canonical.local_pose.at(0, 5).confidence = 0;  // before its first: first
+  canonical.local_pose.at(2, 7).confidence = 0;  // later: the last present
+  const std::vector<float> rows = CanonicalFeatures(canonical);
+  const int size = CanonicalFrameSize(Coco17Layout());
+  EXPECT_FLOAT_EQ(rows[0 * size + 2 * 5], 0.1f);
+  EXPECT_FLOAT_EQ(rows[2 * size + 2 * 7], 0.1f);
+  EXPECT_FLOAT_EQ(rows[2 * size + 2 * 8], 0.2f);
+}
+
+TEST(GenDataset, EveryMotionIsSeenFromEveryView) {
+  GenViewOptions views;
+  views.num_azimuths = 3;
+  views.elevations_deg = {0, 25};
+  const GenDataset dataset = BuildGenDataset({WalkSource()}, views, 30.0, 4.0);
+  ASSERT_EQ(dataset.sequences.size(), 6u);
+  EXPECT_EQ(dataset.frame_size, 37);
+  // The cycle (1.2 s) looped to 4 s.
+  EXPECT_EQ(dataset.sequences[0].num_frames, 121);
+  EXPECT_EQ(dataset.num_frames(), 6 * 121);
+  // Local poses are in units of the body's scale: unit RMS about the root.
+  ASSERT_EQ(dataset.mean.size(), 37u);
+  for (float s : dataset.std) EXPECT_GE(s, kMinFeatureStd);
+  // Views differ: the same frame's local pose from two azimuths.
+  const float* a = dataset.sequences[0].features.data();
+  const float* b = dataset.sequences[1].features.data();
+  double difference = 0;
+  for (int c = 0; c < 34; ++c) difference += std::abs(a[c] - b[c]);
+  EXPECT_GT(difference, 0.5);
+}
+
+TEST(GenDataset, RejectsViewsThatCannotBe) {
+  GenViewOptions views;
+  views.elevations_deg = {};
+  EXPECT_THROW(views.Validate(), ConfigError);
+  views.elevations_deg = {85};
+  EXPECT_THROW(views.Validate(), ConfigError);
+  views.elevations_deg = {10};
+  views.num_azimuths = 0;
+  EXPECT_THROW(views.Validate(), ConfigError);
+}
+
+}  // namespace
+}  // namespace m2d
