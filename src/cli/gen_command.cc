@@ -28,6 +28,9 @@ struct GenTrainArgs {
   std::string config_path;
   bool resume = false;
   bool list_settings = false;
+  std::string run_dir;           // overrides run.run_dir
+  int64_t tokenizer_steps = -1;  // overrides tokenizer.steps (-1: keep)
+  int64_t prior_steps = -1;      // overrides prior.steps
 };
 
 // The dataset of `motions` (files) seen from a config's views.
@@ -54,7 +57,10 @@ int RunGenTrain(const GenTrainArgs& args) {
   if (args.config_path.empty())
     throw InputError("",
                      "gen train: give a config (e.g. configs/gen/clips.yaml)");
-  const GenConfig config = LoadGenConfig(args.config_path);
+  GenConfig config = LoadGenConfig(args.config_path);
+  if (!args.run_dir.empty()) config.run.run_dir = args.run_dir;
+  if (args.tokenizer_steps >= 0) config.tokenizer.steps = args.tokenizer_steps;
+  if (args.prior_steps >= 0) config.prior.steps = args.prior_steps;
   std::signal(SIGINT, RequestGenStop);
   std::signal(SIGTERM, RequestGenStop);
   const GenDataset dataset = LoadGenDataset(config, config.data.motions);
@@ -194,21 +200,28 @@ int RunGenEval(const GenEvalArgs& args) {
       EvaluateGenerator(args.run_dir, real, held_apart, args.options);
   std::printf("%s", result.BriefReport().c_str());
   if (!args.output.empty()) {
-    nlohmann::json json = {{"run_dir", args.run_dir},
-                           {"generations", args.options.generations},
-                           {"seconds", args.options.seconds},
-                           {"temperature", args.options.sampling.temperature},
-                           {"top_k", args.options.sampling.top_k},
-                           {"held_apart", args.held_apart},
-                           {"fid", result.fid},
-                           {"fid_floor", result.fid_floor},
-                           {"diversity_real", result.diversity_real},
-                           {"diversity_generated", result.diversity_generated},
-                           {"real_windows", result.real_windows},
-                           {"held_apart_windows", result.held_apart_windows},
-                           {"generated_windows", result.generated_windows},
-                           {"encoder_loss", result.encoder_loss},
-                           {"realtime_factor", result.realtime_factor}};
+    nlohmann::json json = {
+        {"run_dir", args.run_dir},
+        {"generations", args.options.generations},
+        {"seconds", args.options.seconds},
+        {"temperature", args.options.sampling.temperature},
+        {"top_k", args.options.sampling.top_k},
+        {"held_apart", args.held_apart},
+        {"fid", result.fid},
+        {"fid_floor", result.fid_floor},
+        {"fid_reconstruction", result.fid_reconstruction},
+        {"reconstruction_pose_error", result.reconstruction_pose_error},
+        {"reconstruction_root_error", result.reconstruction_root_error},
+        {"reconstruction_scale_error", result.reconstruction_scale_error},
+        {"decode_context_codes", args.options.decoding.context_codes},
+        {"lookahead_codes", args.options.decoding.lookahead_codes},
+        {"diversity_real", result.diversity_real},
+        {"diversity_generated", result.diversity_generated},
+        {"real_windows", result.real_windows},
+        {"held_apart_windows", result.held_apart_windows},
+        {"generated_windows", result.generated_windows},
+        {"encoder_loss", result.encoder_loss},
+        {"realtime_factor", result.realtime_factor}};
     WriteFileAtomic(args.output, json.dump(2) + "\n");
   }
   return 0;
@@ -229,6 +242,15 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->check(CLI::ExistingFile);
   train->add_flag("--resume", train_args->resume,
                   "Continue from <run_dir>/tokenizer.pt and prior.pt");
+  train->add_option("--run-dir", train_args->run_dir, "Override run.run_dir");
+  train
+      ->add_option("--tokenizer-steps", train_args->tokenizer_steps,
+                   "Override tokenizer.steps (a quick try: a few hundred)")
+      ->check(CLI::NonNegativeNumber);
+  train
+      ->add_option("--prior-steps", train_args->prior_steps,
+                   "Override prior.steps")
+      ->check(CLI::NonNegativeNumber);
   train->add_flag("--list-settings", train_args->list_settings,
                   "Print every config setting (Markdown) and exit");
   train->callback([run, train_args] {
@@ -256,6 +278,11 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Motions the feature encoder is trained on (never the "
                    "generator's)")
       ->delimiter(',');
+  eval->add_option("--decode-context",
+                   eval_args->options.decoding.context_codes,
+                   "Codes the streaming decoder sees per step");
+  eval->add_option("--lookahead", eval_args->options.decoding.lookahead_codes,
+                   "Codes decoded after the one emitted (latency)");
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
   eval->add_option("-o,--output", eval_args->output, "Figures as JSON");

@@ -81,6 +81,7 @@ torch::Tensor DatasetWindows(const std::vector<GenSequence>& sequences,
 FeatureEncoder TrainFeatureEncoder(const torch::Tensor& windows, int frame_size,
                                    const FeatureEncoderOptions& options,
                                    uint64_t seed, double* final_loss) {
+  torch::AutoGradMode grad_mode(true);  // even under a caller's NoGradGuard
   torch::manual_seed(seed);
   FeatureEncoder encoder(frame_size, options);
   torch::optim::AdamW optimizer(

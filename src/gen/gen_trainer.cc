@@ -28,7 +28,7 @@ std::string GenTrainSummary::BriefReport() const {
   out << (interrupted ? "interrupted" : "finished") << ": tokenizer "
       << tokenizer_steps << " steps (loss " << tokenizer_loss << "), prior "
       << prior_steps << " steps (cross-entropy " << prior_loss << " nats)\n"
-      << "  " << tokenizer_path << "\n  " << prior_path << "\n";
+      << "  checkpoints: " << tokenizer_path << ", " << prior_path << "\n";
   return out.str();
 }
 

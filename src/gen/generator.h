@@ -28,13 +28,20 @@ struct GeneratedMotion {
 
 // `seconds` of motion streamed from the run's prior and tokenizer
 // (gen/motion_stream.h), with `sampling` and `seed`.
+// The stream's decoding window (gen/motion_stream.h).
+struct StreamDecoding {
+  int context_codes = 16;
+  int lookahead_codes = 1;
+};
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
-                               const SamplingOptions& sampling, uint64_t seed);
+                               const SamplingOptions& sampling, uint64_t seed,
+                               const StreamDecoding& decoding = {});
 
 struct GeneratorEvalOptions {
   int generations = 10;   // independent streams (seeds 1..N)
   double seconds = 60.0;  // per generation
   SamplingOptions sampling;
+  StreamDecoding decoding;
   int window_frames = 64;  // feature windows
   int stride_frames = 16;
   int64_t encoder_steps = 3000;
@@ -43,8 +50,13 @@ struct GeneratorEvalOptions {
 
 struct GeneratorEvalResult {
   int real_windows = 0, held_apart_windows = 0, generated_windows = 0;
-  double encoder_loss = 0.0;    // reconstruction MSE at the end
-  double fid = 0.0;             // generated vs real
+  double encoder_loss = 0.0;  // reconstruction MSE at the end
+  double fid = 0.0;           // generated vs real
+  // The tokenizer alone: every real window encoded and decoded.
+  double fid_reconstruction = 0.0;
+  // Its mean |error| per channel group of X^can (body-scale units).
+  double reconstruction_pose_error = 0.0, reconstruction_root_error = 0.0,
+         reconstruction_scale_error = 0.0;
   double fid_floor = 0.0;       // real vs real: two halves of the sequences
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;

@@ -18,19 +18,22 @@ MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                       std::to_string(tokenizer_.model->num_codes()) +
                       ": they come from different runs");
   }
-  if (options_.decode_context_codes < 2)
-    throw ConfigError("decode_context_codes must be at least 2");
+  if (options_.lookahead_codes < 0 ||
+      options_.decode_context_codes < options_.lookahead_codes + 1)
+    throw ConfigError(
+        "stream: lookahead_codes must be >= 0 and decode_context_codes > "
+        "lookahead_codes");
   tokenizer_.model->eval();
 }
 
 void MotionStream::Next(std::vector<float>* rows) {
   torch::NoGradGuard no_grad;
-  // Outline: draw codes until the one after the next code to emit exists;
-  // decode the latest codes; keep the frames of the code to emit.
-  while (static_cast<int64_t>(sampler_.codes().size()) < emitted_codes_ + 2)
-    sampler_.Next();
+  // Outline: draw codes until the lookahead after the next code to emit
+  // exists; decode the latest codes; keep the frames of the code to emit.
+  const int64_t end = emitted_codes_ + 1 + options_.lookahead_codes;
+  while (static_cast<int64_t>(sampler_.codes().size()) < end) sampler_.Next();
   const std::vector<int64_t>& codes = sampler_.codes();
-  const int64_t end = emitted_codes_ + 2;  // codes [begin, end) are decoded
+  // Codes [begin, end) are decoded.
   const int64_t begin =
       std::max<int64_t>(0, end - options_.decode_context_codes);
   torch::Tensor window =

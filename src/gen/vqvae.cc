@@ -90,7 +90,16 @@ CodebookStats CodebookImpl::Update(const torch::Tensor& z,
   ema_sum_.mul_(ema_decay_).add_(sums, 1.0 - ema_decay_);
   torch::Tensor alive = (ema_count_ >= 1.0).unsqueeze(1);
   torch::Tensor means = ema_sum_ / ema_count_.clamp_min(1e-5).unsqueeze(1);
-  codes_.copy_(torch::where(alive, means, random_rows()));
+  // A reset code restarts its averages at its new vector with a count of
+  // 1 (Jukebox's reset): it stays while at least about one vector a step
+  // chooses it. Keeping the faded averages (T2M-GPT) needs ~100 vectors in
+  // one batch to revive a code (0.99 c + 0.01 n >= 1), so a dead code was
+  // re-drawn every step: about 270 of 512 codes, batch after batch.
+  torch::Tensor replacements = random_rows();
+  codes_.copy_(torch::where(alive, means, replacements));
+  ema_sum_.copy_(torch::where(alive, ema_sum_, replacements));
+  ema_count_.copy_(
+      torch::where(alive.squeeze(1), ema_count_, torch::ones_like(ema_count_)));
 
   torch::Tensor share = counts / static_cast<double>(rows);
   stats.perplexity =

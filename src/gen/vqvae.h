@@ -41,8 +41,8 @@ struct CodebookStats {
 
 // K codes of size D. Training moves each code toward the mean of the
 // vectors assigned to it (moving averages of counts and sums) and replaces
-// a code whose moving count fell below 1 by a random vector of the batch;
-// the first training batch seeds every code.
+// a code whose moving count fell below 1 by a random vector of the batch,
+// its averages restarted there; the first training batch seeds every code.
 class CodebookImpl : public torch::nn::Module {
  public:
   CodebookImpl(int num_codes, int code_size, double ema_decay);
