@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "common/error.h"
@@ -24,10 +25,21 @@ const char* SettingName(GenStage stage) {
 }
 
 std::string GenTrainSummary::BriefReport() const {
+  // NaN: the stage took no step in this run (already trained).
+  auto figure = [](const char* name, double value, const char* unit) {
+    std::ostringstream text;
+    if (std::isnan(value)) {
+      text << "no step this run";
+    } else {
+      text << name << " " << value << unit;
+    }
+    return text.str();
+  };
   std::ostringstream out;
   out << (interrupted ? "interrupted" : "finished") << ": tokenizer "
-      << tokenizer_steps << " steps (loss " << tokenizer_loss << "), prior "
-      << prior_steps << " steps (cross-entropy " << prior_loss << " nats)\n"
+      << tokenizer_steps << " steps (" << figure("loss", tokenizer_loss, "")
+      << "), prior " << prior_steps << " steps ("
+      << figure("cross-entropy", prior_loss, " nats") << ")\n"
       << "  checkpoints: " << tokenizer_path << ", " << prior_path << "\n";
   return out.str();
 }
@@ -195,6 +207,7 @@ double RunStage(const StageContext& context, GenStage stage, int64_t steps,
   GenProgress progress;
   progress.stage = stage;
   progress.steps = steps;
+  progress.loss = std::numeric_limits<double>::quiet_NaN();  // until a report
   auto checkpoint = [&] {
     clock.last_checkpoint = Clock::now();
     state->seconds = clock.seconds();

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include "gen/gen_config.h"
@@ -37,7 +38,9 @@ struct GenProgress {
 struct GenTrainSummary {
   bool interrupted = false;
   int64_t tokenizer_steps = 0, prior_steps = 0;
-  double tokenizer_loss = 0.0, prior_loss = 0.0;  // last reported
+  // Last reported; NaN when the stage took no step in this run.
+  double tokenizer_loss = std::numeric_limits<double>::quiet_NaN();
+  double prior_loss = std::numeric_limits<double>::quiet_NaN();
   std::string tokenizer_path, prior_path;
   // A few lines: steps, final losses, codebook use, files.
   std::string BriefReport() const;
