@@ -114,7 +114,7 @@ struct GenerateArgs {
 // The first frame's root and scale: the character standing at the origin,
 // seen from the chosen view (what the tracker starts from).
 void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
-                       double* scale_px, PinholeCamera* camera) {
+                       double* scale_px) {
   RigOptions rig;
   rig.num_views = 1;
   rig.first_azimuth_deg = args.view[0];
@@ -122,7 +122,7 @@ void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
   rig.distance_m = args.view[2];
   rig.focal_px = args.focal_px;
   rig.Validate();
-  *camera = MakeRig(rig).front().camera;
+  const PinholeCamera camera = MakeRig(rig).front().camera;
   auto skeleton = std::make_shared<const Skeleton>(
       LoadSkeleton(AssetPath("skeletons/humanoid.yaml")));
   const KeypointMap map =
@@ -137,7 +137,7 @@ void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
   frame.keypoints = KeypointTrack(1, static_cast<int>(points.size()));
   for (size_t j = 0; j < points.size(); ++j) {
     const Projection p =
-        camera->Project(points[j] - Eigen::Vector3d(0, 0, lowest_m));
+        camera.Project(points[j] - Eigen::Vector3d(0, 0, lowest_m));
     frame.keypoints.at(0, static_cast<int>(j)) = {p.pixel_px.x(),
                                                   p.pixel_px.y(), 1.0};
   }
@@ -162,8 +162,7 @@ int RunGenerate(const GenerateArgs& args) {
 
   Eigen::Vector2d root_px;
   double scale_px = 0.0;
-  PinholeCamera camera;
-  StandingPlacement(args, &root_px, &scale_px, &camera);
+  StandingPlacement(args, &root_px, &scale_px);
   Clip2D clip = FromCanonical(CanonicalFromFeatures(
       motion.rows.data(), frames, Coco17Layout(), fps, root_px, scale_px));
   WriteClip(args.output, clip);

@@ -133,6 +133,17 @@ struct SamplingOptions {
   int top_k = 0;             // sample among the k likeliest codes (0: all)
 };
 
+// How the stream decodes codes into frames (gen/motion_stream.h).
+struct StreamDecoding {
+  // Codes the decoder sees per step. Its receptive field spans about ±15
+  // codes (dilations 9, 3, 1 at the code rate); more costs time, fewer
+  // makes the seams between codes show.
+  int context_codes = 16;
+  // Codes decoded after the one emitted (latency, 4 frames each): the
+  // decoder is least sure at the window's open edge.
+  int lookahead_codes = 1;
+};
+
 // Where and how a run goes.
 struct GenRunOptions {
   std::string run_dir = "runs/gen";  // tokenizer.pt, prior.pt, logs

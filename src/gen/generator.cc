@@ -21,23 +21,14 @@ GenConfig ReadGeneratorConfig(const std::string& run_dir) {
       .config;
 }
 
-GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
-                               const SamplingOptions& sampling, uint64_t seed,
-                               const StreamDecoding& decoding) {
-  if (!(sampling.temperature > 0) || sampling.top_k < 0)
-    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
-  if (!(seconds > 0 && seconds <= 24 * 3600))
-    throw ConfigError("generation length must be in (0, 86400] s");
-  const std::filesystem::path run(run_dir);
-  LoadedTokenizer tokenizer = LoadTokenizer((run / kTokenizerFile).string());
-  LoadedPrior prior = LoadPrior((run / kPriorFile).string());
+namespace {
+
+// `seconds` of motion streamed from loaded models.
+GeneratedMotion Generate(const LoadedTokenizer& tokenizer,
+                         const LoadedPrior& prior, double seconds,
+                         const MotionStreamOptions& options) {
   GeneratedMotion motion;
   motion.fps = tokenizer.config.data.fps;
-  MotionStreamOptions options;
-  options.sampling = sampling;
-  options.seed = seed;
-  options.decode_context_codes = decoding.context_codes;
-  options.lookahead_codes = decoding.lookahead_codes;
   MotionStream stream(tokenizer, prior, options);
   const int frame_size = stream.frame_size();
   motion.num_frames = static_cast<int>(std::ceil(seconds * motion.fps));
@@ -50,6 +41,25 @@ GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
   motion.rows.resize(static_cast<size_t>(motion.num_frames) * frame_size);
   motion.num_codes = static_cast<int>(stream.codes().size());
   return motion;
+}
+
+void CheckGeneration(double seconds, const SamplingOptions& sampling) {
+  if (!(sampling.temperature > 0) || sampling.top_k < 0)
+    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
+  if (!(seconds > 0 && seconds <= 24 * 3600))
+    throw ConfigError("generation length must be in (0, 86400] s");
+}
+
+}  // namespace
+
+GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
+                               const SamplingOptions& sampling, uint64_t seed,
+                               const StreamDecoding& decoding) {
+  CheckGeneration(seconds, sampling);
+  const std::filesystem::path run(run_dir);
+  return Generate(LoadTokenizer((run / kTokenizerFile).string()),
+                  LoadPrior((run / kPriorFile).string()), seconds,
+                  {sampling, decoding, seed});
 }
 
 std::string GeneratorEvalResult::BriefReport() const {
@@ -131,9 +141,12 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   torch::set_num_threads(1);
   std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
+  CheckGeneration(options.seconds, options.sampling);
+  const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
-    GeneratedMotion motion = GenerateMotion(
-        run_dir, options.seconds, options.sampling, g + 1, options.decoding);
+    GeneratedMotion motion = Generate(
+        tokenizer, prior, options.seconds,
+        {options.sampling, options.decoding, static_cast<uint64_t>(g + 1)});
     generation_s += motion.generation_s;
     generated_s += motion.num_frames / motion.fps;
     generated.push_back({"generated/" + std::to_string(g + 1),

@@ -28,11 +28,6 @@ struct GeneratedMotion {
 
 // `seconds` of motion streamed from the run's prior and tokenizer
 // (gen/motion_stream.h), with `sampling` and `seed`.
-// The stream's decoding window (gen/motion_stream.h).
-struct StreamDecoding {
-  int context_codes = 16;
-  int lookahead_codes = 1;
-};
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
                                const SamplingOptions& sampling, uint64_t seed,
                                const StreamDecoding& decoding = {});

@@ -18,10 +18,11 @@ MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                       std::to_string(tokenizer_.model->num_codes()) +
                       ": they come from different runs");
   }
-  if (options_.lookahead_codes < 0 ||
-      options_.decode_context_codes < options_.lookahead_codes + 1)
+  const StreamDecoding& decoding = options_.decoding;
+  if (decoding.lookahead_codes < 0 ||
+      decoding.context_codes < decoding.lookahead_codes + 1)
     throw ConfigError(
-        "stream: lookahead_codes must be >= 0 and decode_context_codes > "
+        "stream: lookahead_codes must be >= 0 and context_codes > "
         "lookahead_codes");
   tokenizer_.model->eval();
 }
@@ -30,12 +31,12 @@ void MotionStream::Next(std::vector<float>* rows) {
   torch::NoGradGuard no_grad;
   // Outline: draw codes until the lookahead after the next code to emit
   // exists; decode the latest codes; keep the frames of the code to emit.
-  const int64_t end = emitted_codes_ + 1 + options_.lookahead_codes;
+  const int64_t end = emitted_codes_ + 1 + options_.decoding.lookahead_codes;
   while (static_cast<int64_t>(sampler_.codes().size()) < end) sampler_.Next();
   const std::vector<int64_t>& codes = sampler_.codes();
   // Codes [begin, end) are decoded.
   const int64_t begin =
-      std::max<int64_t>(0, end - options_.decode_context_codes);
+      std::max<int64_t>(0, end - options_.decoding.context_codes);
   torch::Tensor window =
       torch::tensor(
           std::vector<int64_t>(codes.begin() + begin, codes.begin() + end),

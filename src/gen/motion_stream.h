@@ -14,19 +14,13 @@ namespace m2d {
 
 struct MotionStreamOptions {
   SamplingOptions sampling;
-  // Codes the decoder sees per step. Its receptive field spans about ±15
-  // codes (dilations 9, 3, 1 at the code rate); more costs time, fewer
-  // makes the seams between codes show.
-  int decode_context_codes = 16;
-  // Codes decoded after the one emitted (latency, 4 frames each): the
-  // decoder is least sure at the window's open edge.
-  int lookahead_codes = 1;
+  StreamDecoding decoding;
   uint64_t seed = 1;
 };
 
 // Each Next() emits one code's frames. The frames of a code are decoded
-// once `lookahead_codes` codes after it exist, so that the decoder does not
-// work at the window's open edge.
+// once `decoding.lookahead_codes` codes after it exist, so that the decoder
+// does not work at the window's open edge.
 class MotionStream {
  public:
   MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,

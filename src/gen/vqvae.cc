@@ -59,11 +59,7 @@ torch::Tensor CodebookImpl::Nearest(const torch::Tensor& z) const {
 }
 
 torch::Tensor CodebookImpl::Lookup(const torch::Tensor& indices) const {
-  return codes_.index_select(0, indices.reshape({-1})).reshape([&] {
-    std::vector<int64_t> shape = indices.sizes().vec();
-    shape.push_back(codes_.size(1));
-    return shape;
-  }());
+  return torch::embedding(codes_, indices);
 }
 
 CodebookStats CodebookImpl::Update(const torch::Tensor& z,
