@@ -20,6 +20,16 @@ void RigOptions::Validate() const {
   }
   if (!(distance_m > 0.1) || !std::isfinite(distance_m))
     throw ConfigError("rig: distance_m must be finite and > 0.1");
+  if (!std::isfinite(distance_span_m) || !(distance_m + distance_span_m > 0.1))
+    throw ConfigError(
+        "rig: distance_m + distance_span_m (the last view's distance) must be "
+        "finite and > 0.1");
+  if (!std::isfinite(elevation_span_deg) ||
+      !(std::abs(elevation_deg + elevation_span_deg) < 89.0)) {
+    throw ConfigError(
+        "rig: |elevation_deg + elevation_span_deg| (the last view's "
+        "elevation) must be < 89");
+  }
   if (!(focal_px > 0) || !std::isfinite(focal_px))
     throw ConfigError("rig: focal_px must be finite and > 0");
   if (width_px < 1 || height_px < 1 || width_px > kMaxImageSidePx ||
@@ -48,15 +58,19 @@ std::vector<NamedCamera> MakeRig(const RigOptions& options) {
   int intervals =
       full_circle ? options.num_views : std::max(1, options.num_views - 1);
   double step_deg = options.azimuth_span_deg / intervals;
-  double elevation = options.elevation_deg * M_PI / 180.0;
 
   std::vector<NamedCamera> rig;
   for (int k = 0; k < options.num_views; ++k) {
+    double share = options.num_views > 1 ? k / (options.num_views - 1.0) : 0.0;
     double azimuth = (options.first_azimuth_deg + k * step_deg) * M_PI / 180.0;
+    double elevation =
+        (options.elevation_deg + share * options.elevation_span_deg) * M_PI /
+        180.0;
+    double distance = options.distance_m + share * options.distance_span_m;
     Eigen::Vector3d direction(std::cos(elevation) * std::cos(azimuth),
                               std::cos(elevation) * std::sin(azimuth),
                               std::sin(elevation));
-    Eigen::Vector3d eye = options.target_m + options.distance_m * direction;
+    Eigen::Vector3d eye = options.target_m + distance * direction;
     rig.push_back({"view" + std::to_string(k),
                    PinholeCamera::LookAt(intrinsics, eye, options.target_m)});
   }

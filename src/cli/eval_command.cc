@@ -1,5 +1,6 @@
-// cli: `mimic2d eval` — roll a trained policy out on every view of its
-// bundles and report Succ, E2D, EO2D, E3D and Jitter (table + JSON).
+// cli: `mimic2d eval` — roll a trained policy out on every view (or set of
+// K views) of its bundles and report Succ, E2D, EO2D, E3D and Jitter (table
+// + JSON).
 #include <cstdio>
 #include <memory>
 
@@ -61,6 +62,11 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
   eval->add_option(
           "--success-px", args->options.success_threshold_px,
           "A frame whose worst keypoint is off by more fails the rollout (px)")
+      ->capture_default_str();
+  eval->add_option("--views", args->options.num_views,
+                   "K: views tracked at once (zero-shot multi-view: phi "
+                   "averaged over each view and the K-1 next views of its "
+                   "bundle); K > 1 needs --cameras truth")
       ->capture_default_str();
   eval->add_option("--starts", args->starts,
                    "Initial states from: truth, estimate (mimic2d fit) or "

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 
 #include "cli/commands.h"
 #include "common/error.h"
@@ -50,6 +51,23 @@ void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
       .add_option("--distance", rig.distance_m,
                   "Camera distance to the subject (m)")
       ->capture_default_str();
+  command
+      .add_option("--elevation-span", rig.elevation_span_deg,
+                  "The last view's elevation exceeds the first's by this "
+                  "(deg); views in between are spread evenly")
+      ->capture_default_str();
+  command
+      .add_option("--distance-span", rig.distance_span_m,
+                  "The last view's distance exceeds the first's by this (m)")
+      ->capture_default_str();
+  command
+      .add_option("--aim", options->aim,
+                  "Rig target: start (the first root) or middle (midway "
+                  "along the subject's path)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, RigAim>{{"start", RigAim::kStartRoot},
+                                        {"middle", RigAim::kPathMiddle}},
+          CLI::ignore_case));
   command.add_option("--focal", rig.focal_px, "Focal length (px)")
       ->capture_default_str();
   command.add_option("--width", rig.width_px, "Image width (px)")

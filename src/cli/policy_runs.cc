@@ -1,5 +1,6 @@
 #include "cli/policy_runs.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -58,10 +59,11 @@ std::string Cell(double value, const char* format) {
   return text;
 }
 
-void PrintRow(const EvalRow& row) {
+// `view_width`: the view column's width (K views' joined names are long).
+void PrintRow(const EvalRow& row, int view_width) {
   std::printf(
-      "%-22s %-7s %5d %7.0f %7s %8s %8s %9s %11s %9s %7s\n", row.bundle.c_str(),
-      row.view.c_str(), row.episodes, row.mean_frames,
+      "%-22s %-*s %5d %7.0f %7s %8s %8s %9s %11s %9s %7s\n", row.bundle.c_str(),
+      view_width, row.view.c_str(), row.episodes, row.mean_frames,
       Cell(100 * row.succ, "%.1f").c_str(), Cell(row.e2d_px, "%.1f").c_str(),
       Cell(row.eo2d_px, "%.1f").c_str(), Cell(row.e3d_mm, "%.0f").c_str(),
       Cell(row.e3d_root_mm, "%.0f").c_str(),
@@ -101,7 +103,8 @@ CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,
     const EvalOptions& options, const SourceOverrides& sources,
     const std::vector<std::string>& truth_paths) {
-  TorchPolicy policy(checkpoint);
+  options.Validate();
+  TorchPolicy policy(checkpoint, options.num_views);
   const TrainConfig& config = policy.config();
   std::vector<std::string> paths =
       bundle_paths.empty() ? config.data.bundles : bundle_paths;
@@ -162,11 +165,14 @@ void PrintEvalTable(const CheckpointEvaluation& evaluation) {
         "estimated world differs from the truth's), E3Droot after the best "
         "rotation about z, E3DPA after a similarity per frame\n");
   }
-  std::printf("%-22s %-7s %5s %7s %7s %8s %8s %9s %11s %9s %7s\n", "clip",
-              "view", "eps", "frames", "Succ%", "E2D(px)", "EO2D(px)",
-              "E3D(mm)", "E3Droot(mm)", "E3DPA(mm)", "Jitter");
-  for (const EvalRow& row : evaluation.rows) PrintRow(row);
-  PrintRow(AggregateRows(evaluation.rows));
+  int view_width = 7;
+  for (const EvalRow& row : evaluation.rows)
+    view_width = std::max(view_width, static_cast<int>(row.view.size()));
+  std::printf("%-22s %-*s %5s %7s %7s %8s %8s %9s %11s %9s %7s\n", "clip",
+              view_width, "view", "eps", "frames", "Succ%", "E2D(px)",
+              "EO2D(px)", "E3D(mm)", "E3Droot(mm)", "E3DPA(mm)", "Jitter");
+  for (const EvalRow& row : evaluation.rows) PrintRow(row, view_width);
+  PrintRow(AggregateRows(evaluation.rows), view_width);
 }
 
 void WriteEvalJson(const std::string& path, const std::string& checkpoint,
@@ -180,6 +186,7 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
       {"starts_from_checkpoint_buffers", evaluation.checkpoint_buffers},
       {"episode_s", options.episode_s},
       {"success_threshold_px", options.success_threshold_px},
+      {"views_at_once", options.num_views},
       {"rows", nlohmann::json::array()},
       {"all", RowToJson(AggregateRows(rows))}};
   for (const EvalRow& row : rows) json["rows"].push_back(RowToJson(row));

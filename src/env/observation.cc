@@ -77,4 +77,17 @@ void WriteNormalizedPoints(const Keypoint2D* points, int num_points,
   }
 }
 
+void WriteRootRelativePoints(const Eigen::Vector3d* points_m, int num_points,
+                             const Eigen::Vector3d& root_m,
+                             const Eigen::Quaterniond& to_heading, float* out) {
+  for (int j = 0; j < num_points; ++j, out += 3) {
+    const Eigen::Vector3d local = to_heading * (points_m[j] - root_m);
+    for (int i = 0; i < 3; ++i) {
+      out[i] = static_cast<float>(
+          std::clamp(local[i], -static_cast<double>(kMaxNormalizedCoordinate),
+                     static_cast<double>(kMaxNormalizedCoordinate)));
+    }
+  }
+}
+
 }  // namespace m2d

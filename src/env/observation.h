@@ -76,6 +76,14 @@ inline constexpr float kMaxNormalizedCoordinate = 10.0f;
 void WriteNormalizedPoints(const Keypoint2D* points, int num_points,
                            const ImageNormalization& normalization, float* out);
 
+// The 3D-tracking baselines' block in place of a 2D one: writes num_points
+// * 3 floats, each point relative to the root `root_m` in the root's heading
+// frame (`to_heading`, InverseHeadingRotation), clipped to
+// +-kMaxNormalizedCoordinate metres.
+void WriteRootRelativePoints(const Eigen::Vector3d* points_m, int num_points,
+                             const Eigen::Vector3d& root_m,
+                             const Eigen::Quaterniond& to_heading, float* out);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_ENV_OBSERVATION_H_

@@ -277,6 +277,34 @@ uint64_t ReferenceFingerprint(const TrackingReference& reference) {
   return hash;
 }
 
+void ReadBodyTarget(const Simulation& simulation, const double* keypoints_xyz,
+                    BodyTarget3D* target) {
+  const Character& character = simulation.character();
+  const mjData* data = simulation.data();
+  const double* root_qpos = data->qpos + character.root_qpos_address();
+  const double* root_qvel = data->qvel + character.root_dof_address();
+  target->root_position_m = {root_qpos[0], root_qpos[1], root_qpos[2]};
+  target->root_orientation =
+      Eigen::Quaterniond(root_qpos[3], root_qpos[4], root_qpos[5], root_qpos[6])
+          .normalized();
+  target->root_linear_velocity_m_s = {root_qvel[0], root_qvel[1], root_qvel[2]};
+  target->root_angular_velocity_rad_s = {root_qvel[3], root_qvel[4],
+                                         root_qvel[5]};
+  const std::vector<ActuatedHinge>& hinges = character.hinges();
+  target->hinge_angles_rad.resize(hinges.size());
+  target->hinge_velocities_rad_s.resize(hinges.size());
+  for (size_t j = 0; j < hinges.size(); ++j) {
+    target->hinge_angles_rad[j] = data->qpos[hinges[j].qpos_address];
+    target->hinge_velocities_rad_s[j] = data->qvel[hinges[j].dof_address];
+  }
+  const int num_keypoints = character.keypoint_layout().num_keypoints();
+  target->keypoints_m.resize(num_keypoints);
+  for (int k = 0; k < num_keypoints; ++k) {
+    target->keypoints_m[k] = {keypoints_xyz[3 * k], keypoints_xyz[3 * k + 1],
+                              keypoints_xyz[3 * k + 2]};
+  }
+}
+
 InitialStates::InitialStates(const TrackingReference& reference,
                              std::shared_ptr<const Character> character,
                              const SimulationOptions& simulation_options,
@@ -298,6 +326,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
   std::vector<Eigen::Vector3d> standing_keypoints =
       SimulatedKeypoints(simulation);
   std::vector<double> qvel(character->model()->nv, 0.0);
+  std::vector<double> keypoints_xyz(
+      3 * character->keypoint_layout().num_keypoints());
   const InitialStateSource source = reference.sources().initial_states;
   const std::vector<TrackedView>& views = reference.views();
 
@@ -315,6 +345,7 @@ InitialStates::InitialStates(const TrackingReference& reference,
     const TrackedView& view = views[first];
     const ReferenceBundle& bundle = reference.bundles()[view.bundle];
     StateBuffer buffer(bundle.num_frames(), options);
+    std::vector<BodyTarget3D> motion(bundle.num_frames());
     for (int t = 0; t < bundle.num_frames(); ++t) {
       simulation.Reset();
       switch (source) {
@@ -341,6 +372,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
               bundle.views[view.view].CameraAt(t), view.normalization[t]));
           break;
       }
+      simulation.KeypointPositions(keypoints_xyz.data());
+      ReadBodyTarget(simulation, keypoints_xyz.data(), &motion[t]);
       if (joint_noise_rad > 0)
         AddJointNoise(joint_noise_rad, noise_rng, simulation);
       const SimState filled = simulation.Save();
@@ -348,6 +381,7 @@ InitialStates::InitialStates(const TrackingReference& reference,
       buffer.SetAnchor(t, filled);
     }
     buffers_.push_back(std::move(buffer));
+    motions_.push_back(std::move(motion));
   }
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "env/observation.h"
+#include "env/reward.h"
 #include "env/sources.h"
 #include "env/state_buffer.h"
 #include "motion/bundle.h"
@@ -73,6 +74,11 @@ class TrackingReference {
 // different motion differ. Reads the 2D only.
 uint64_t ReferenceFingerprint(const TrackingReference& reference);
 
+// The simulation's current state as 3D tracking compares it, with
+// `keypoints_xyz` its KeypointPositions (reuses `target`'s vectors).
+void ReadBodyTarget(const Simulation& simulation, const double* keypoints_xyz,
+                    BodyTarget3D* target);
+
 // Initial-state buffers. From the truth or the default pose, one per bundle
 // (frames are shared by its views: they show the same motion, in one world
 // frame); from an estimate, one per view (each view's poses are in its own
@@ -108,6 +114,12 @@ class InitialStates {
   const StateBuffer& BufferOfView(int view_index) const {
     return buffers_[BufferOf(view_index)];
   }
+  // The motion buffer `index` was filled from, per frame, before any noise:
+  // the truth's or a view's fitted poses (or the placed default pose), as
+  // the character holds them. The 3D-tracking baselines' reference.
+  const std::vector<BodyTarget3D>& motion(int index) const {
+    return motions_[index];
+  }
   // ReferenceFingerprint of the reference the buffers were filled for: a
   // checkpoint's buffers are restored only into the same reference.
   uint64_t reference_fingerprint() const { return reference_fingerprint_; }
@@ -115,6 +127,7 @@ class InitialStates {
  private:
   uint64_t reference_fingerprint_ = 0;
   std::vector<StateBuffer> buffers_;
+  std::vector<std::vector<BodyTarget3D>> motions_;
   std::vector<int> buffer_of_view_;
 };
 

@@ -55,8 +55,92 @@ RewardTerms ComputeReward(const ReprojectionError& pose_error,
   return terms;
 }
 
+ReprojectionError CombineViewErrors(const ReprojectionError* errors,
+                                    int num_views) {
+  if (num_views == 1) return errors[0];
+  ReprojectionError combined;
+  int measured_views = 0;  // a view without keypoints this frame has no mean
+  for (int k = 0; k < num_views; ++k) {
+    combined.max_px = std::max(combined.max_px, errors[k].max_px);
+    combined.num_present += errors[k].num_present;
+    combined.any_behind_camera |= errors[k].any_behind_camera;
+    if (errors[k].num_present == 0) continue;
+    combined.weighted_sum_px += errors[k].weighted_sum_px;
+    combined.mean_px += errors[k].mean_px;
+    ++measured_views;
+  }
+  if (measured_views > 0) {
+    combined.weighted_sum_px /= measured_views;
+    combined.mean_px /= measured_views;
+  }
+  return combined;
+}
+
 bool ShouldExitEarly(const ReprojectionError& error, double max_error_px) {
   return error.any_behind_camera || error.max_px > max_error_px;
+}
+
+Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,
+                                  const BodyTarget3D& reference) {
+  Tracking3DError error;
+  for (size_t j = 0; j < reference.hinge_angles_rad.size(); ++j) {
+    const double angle =
+        simulated.hinge_angles_rad[j] - reference.hinge_angles_rad[j];
+    const double velocity = simulated.hinge_velocities_rad_s[j] -
+                            reference.hinge_velocities_rad_s[j];
+    error.hinge_sq_rad2 += angle * angle;
+    error.hinge_velocity_sq += velocity * velocity;
+  }
+  error.root_position_sq_m2 =
+      (simulated.root_position_m - reference.root_position_m).squaredNorm();
+  const double root_angle =
+      simulated.root_orientation.angularDistance(reference.root_orientation);
+  error.root_rotation_sq_rad2 = root_angle * root_angle;
+  error.root_velocity_sq =
+      (simulated.root_linear_velocity_m_s - reference.root_linear_velocity_m_s)
+          .squaredNorm() +
+      0.1 * (simulated.root_angular_velocity_rad_s -
+             reference.root_angular_velocity_rad_s)
+                .squaredNorm();
+  const size_t num_keypoints = reference.keypoints_m.size();
+  double sum_m = 0.0;
+  for (size_t k = 0; k < num_keypoints; ++k) {
+    const Eigen::Vector3d local =
+        (simulated.keypoints_m[k] - simulated.root_position_m) -
+        (reference.keypoints_m[k] - reference.root_position_m);
+    error.keypoint_local_sq_m2 += local.squaredNorm();
+    const double distance_m =
+        (simulated.keypoints_m[k] - reference.keypoints_m[k]).norm();
+    error.max_keypoint_m = std::max(error.max_keypoint_m, distance_m);
+    sum_m += distance_m;
+  }
+  if (num_keypoints > 0) error.mean_keypoint_m = sum_m / num_keypoints;
+  return error;
+}
+
+void Body3DRewardWeights::Validate() const {
+  CheckRanges(*this, "env.reward_3d");
+}
+
+RewardTerms ComputeReward3D(const Tracking3DError& error, double abs_power_w,
+                            const Body3DRewardWeights& weights,
+                            double energy_weight) {
+  RewardTerms terms;
+  terms.pose =
+      weights.pose_weight *
+          std::exp(-weights.pose_scale * error.hinge_sq_rad2) +
+      weights.velocity_weight *
+          std::exp(-weights.velocity_scale * error.hinge_velocity_sq) +
+      weights.root_weight *
+          std::exp(-weights.root_scale * (error.root_position_sq_m2 +
+                                          0.1 * error.root_rotation_sq_rad2)) +
+      weights.root_velocity_weight *
+          std::exp(-weights.root_velocity_scale * error.root_velocity_sq) +
+      weights.keypoint_weight *
+          std::exp(-weights.keypoint_scale * error.keypoint_local_sq_m2);
+  terms.energy = -abs_power_w;
+  terms.total = terms.pose + energy_weight * terms.energy;
+  return terms;
 }
 
 }  // namespace m2d

@@ -3,6 +3,10 @@
 #ifndef MIMIC2D_ENV_REWARD_H_
 #define MIMIC2D_ENV_REWARD_H_
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
 #include "common/settings.h"
 #include "motion/clip2d.h"
 
@@ -52,7 +56,9 @@ struct RewardWeights {
 };
 
 struct RewardTerms {
-  double pose = 0.0;    // exp(-alpha * weighted_sum_px), in (0, 1]
+  // The tracking term: exp(-alpha * weighted_sum_px), in (0, 1]; for 3D
+  // tracking the weighted sum of its terms.
+  double pose = 0.0;
   double energy = 0.0;  // -sum_j |qdot_j tau_j| (W), <= 0
   double object = 0.0;  // exp(-alpha_o * object error), 0 if untracked
   double total = 0.0;   // w_p pose + w_e energy + w_o object
@@ -65,9 +71,98 @@ RewardTerms ComputeReward(const ReprojectionError& pose_error,
                           const ReprojectionError* object_error,
                           const RewardWeights& weights);
 
+// One frame's errors in K views of the same motion, as one: the worst
+// keypoint of any view; the sums and means averaged over the views that
+// had keypoints; the present counts summed; behind the camera in any. K = 1
+// returns the error itself.
+ReprojectionError CombineViewErrors(const ReprojectionError* errors,
+                                    int num_views);
+
 // Reprojection early exit: the episode ends when the worst keypoint is more
 // than `max_error_px` off, or any keypoint projects behind the camera.
 bool ShouldExitEarly(const ReprojectionError& error, double max_error_px);
+
+// ---- 3D tracking (the 3D-supervised and two-stage baselines) ----
+
+// The character's state at one frame, as 3D tracking compares it: root
+// pose and velocity (MuJoCo's free joint: linear velocity in the world,
+// angular in the root's frame), hinge angles and velocities, keypoints.
+struct BodyTarget3D {
+  Eigen::Vector3d root_position_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond root_orientation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d root_linear_velocity_m_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d root_angular_velocity_rad_s = Eigen::Vector3d::Zero();
+  std::vector<double> hinge_angles_rad, hinge_velocities_rad_s;
+  std::vector<Eigen::Vector3d> keypoints_m;
+};
+
+// How far a simulated state is from its 3D reference frame.
+struct Tracking3DError {
+  double hinge_sq_rad2 = 0.0;          // sum_j (q_j - q^_j)^2
+  double hinge_velocity_sq = 0.0;      // sum_j (qdot_j - qdot^_j)^2
+  double root_position_sq_m2 = 0.0;    // |p - p^|^2 (world)
+  double root_rotation_sq_rad2 = 0.0;  // angle(R, R^)^2
+  double root_velocity_sq = 0.0;       // |v - v^|^2 + 0.1 |w - w^|^2
+  double keypoint_local_sq_m2 = 0.0;   // sum_k |(x_k - p) - (x^_k - p^)|^2
+  double max_keypoint_m = 0.0;         // worst |x_k - x^_k| (world)
+  double mean_keypoint_m = 0.0;        // mean |x_k - x^_k| (world)
+};
+
+// Compares two states of the same character (sizes must agree).
+Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,
+                                  const BodyTarget3D& reference);
+
+// DeepMimic-style terms, with MimicKit's weights and scales as defaults
+// (../shared/notes/reference-settings.md); hinge angles stand in for
+// DeepMimic's joint quaternions.
+struct Body3DRewardWeights {
+  double pose_weight = 0.5;             // on exp(-pose_scale * hinge_sq)
+  double pose_scale = 2.0;              // 1/rad^2
+  double velocity_weight = 0.1;         // on exp(-velocity_scale * vel_sq)
+  double velocity_scale = 0.1;          // 1/(rad/s)^2
+  double root_weight = 0.15;            // on exp(-root_scale * (pos + 0.1 rot))
+  double root_scale = 5.0;              // 1/m^2
+  double root_velocity_weight = 0.1;    // on exp(-root_velocity_scale * ...)
+  double root_velocity_scale = 1.0;     // 1/(m/s)^2
+  double keypoint_weight = 0.15;        // on exp(-keypoint_scale * sum)
+  double keypoint_scale = 10.0;         // 1/m^2
+  double early_exit_max_error_m = 0.5;  // worst keypoint farther ends the
+                                        // episode (0: never)
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("pose_weight", self.pose_weight, Range::AtLeast(0),
+      "weight of exp(-pose_scale * sum of squared hinge-angle errors)");
+    v("pose_scale", self.pose_scale, Range::AtLeast(0), "1/rad^2");
+    v("velocity_weight", self.velocity_weight, Range::AtLeast(0),
+      "weight of exp(-velocity_scale * sum of squared hinge-velocity "
+      "errors)");
+    v("velocity_scale", self.velocity_scale, Range::AtLeast(0), "1/(rad/s)^2");
+    v("root_weight", self.root_weight, Range::AtLeast(0),
+      "weight of exp(-root_scale * (root position error^2 + 0.1 root "
+      "rotation error^2))");
+    v("root_scale", self.root_scale, Range::AtLeast(0), "1/m^2");
+    v("root_velocity_weight", self.root_velocity_weight, Range::AtLeast(0),
+      "weight of exp(-root_velocity_scale * (linear^2 + 0.1 angular^2 "
+      "velocity error))");
+    v("root_velocity_scale", self.root_velocity_scale, Range::AtLeast(0),
+      "1/(m/s)^2");
+    v("keypoint_weight", self.keypoint_weight, Range::AtLeast(0),
+      "weight of exp(-keypoint_scale * sum of squared root-relative "
+      "keypoint errors)");
+    v("keypoint_scale", self.keypoint_scale, Range::AtLeast(0), "1/m^2");
+    v("early_exit_max_error_m", self.early_exit_max_error_m, Range::AtLeast(0),
+      "an episode ends when a keypoint is farther than this from its 3D "
+      "reference (m; 0: never)");
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// r = sum of the weighted terms above + w_e r_e (the energy term of the 2D
+// reward, so that the tracking term is the only difference).
+RewardTerms ComputeReward3D(const Tracking3DError& error, double abs_power_w,
+                            const Body3DRewardWeights& weights,
+                            double energy_weight);
 
 }  // namespace m2d
 

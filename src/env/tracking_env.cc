@@ -11,13 +11,33 @@ void TrackingEnvOptions::Validate() const { CheckRanges(*this, "env"); }
 TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
                          std::shared_ptr<const TrackingReference> reference,
                          std::shared_ptr<const InitialStates> initial_states,
-                         const TrackingEnvOptions& options, uint64_t seed)
+                         const TrackingEnvOptions& options, uint64_t seed,
+                         int num_observed_views)
     : reference_(std::move(reference)),
       initial_states_(std::move(initial_states)),
       options_(options),
       simulation_(character, options.simulation),
-      rng_(seed) {
+      rng_(seed),
+      num_observed_views_(num_observed_views) {
   options_.Validate();
+  if (num_observed_views < 1 || num_observed_views > kMaxObservedViews) {
+    throw ConfigError("env: num_observed_views must be in [1, " +
+                      std::to_string(kMaxObservedViews) + "], got " +
+                      std::to_string(num_observed_views));
+  }
+  observed_views_.resize(num_observed_views, nullptr);
+  if (options_.target == TrackingTarget::kBody3D) {
+    // The 3D baselines follow the initial states' motion, alone.
+    if (num_observed_views != 1)
+      throw ConfigError("env: target body_3d observes one view");
+    if (reference_->num_object_points() > 0)
+      throw ConfigError("env: target body_3d does not track objects");
+    if (reference_->sources().initial_states == InitialStateSource::kDefault) {
+      throw ConfigError(
+          "env: target body_3d needs a 3D reference: initial_states truth "
+          "or estimate, not default");
+    }
+  }
   layout_.num_bodies = static_cast<int>(character->bodies().size());
   layout_.num_objects = reference_->num_object_points();
   layout_.num_points = reference_->num_points();
@@ -26,9 +46,10 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   const int num_points = reference_->num_points();
   const int num_keypoints = character->keypoint_layout().num_keypoints();
   keypoints_xyz_.resize(3 * num_keypoints);
-  projected_xy_.resize(2 * num_points);
-  in_front_.reset(new bool[num_points]);
-  projected_points_.resize(num_points);
+  current_points_m_.resize(num_points);
+  projected_xy_.resize(2 * num_points * num_observed_views);
+  in_front_.reset(new bool[num_points * num_observed_views]);
+  projected_points_.resize(num_points * num_observed_views);
   const size_t num_bodies = character->bodies().size();
   bodies_.positions_m.resize(num_bodies);
   bodies_.orientations.resize(num_bodies);
@@ -52,15 +73,50 @@ void TrackingEnv::Reset(float* observation) {
 
 void TrackingEnv::ResetTo(int view_index, int frame, const SimState& state,
                           float* observation) {
+  if (num_observed_views_ != 1) {
+    throw ConfigError("env: an environment observing " +
+                      std::to_string(num_observed_views_) +
+                      " views starts with ResetToViews");
+  }
   simulation_.Restore(state);
-  BeginEpisode(view_index, frame);
+  observed_views_[0] = &reference_->views()[view_index];
+  episode_.view_index = view_index;
+  BeginEpisode(frame);
   ProjectCurrentPoints();
   WriteObservation(observation);
 }
 
-void TrackingEnv::BeginEpisode(int view_index, int frame) {
-  view_ = &reference_->views()[view_index];
+void TrackingEnv::ResetToViews(const std::vector<int>& view_indices, int frame,
+                               const SimState& state, float* observation) {
+  // Outline: check that the views are K views of one bundle, then start as
+  // ResetTo does.
+  if (static_cast<int>(view_indices.size()) != num_observed_views_) {
+    throw ConfigError("env: " + std::to_string(view_indices.size()) +
+                      " views given to an environment observing " +
+                      std::to_string(num_observed_views_));
+  }
+  const std::vector<TrackedView>& views = reference_->views();
+  for (size_t k = 0; k < view_indices.size(); ++k) {
+    const int index = view_indices[k];
+    if (index < 0 || index >= static_cast<int>(views.size()) ||
+        views[index].bundle != views[view_indices[0]].bundle) {
+      throw ConfigError(
+          "env: the observed views must be views of one bundle (view index " +
+          std::to_string(index) + ")");
+    }
+    observed_views_[k] = &views[index];
+  }
+  simulation_.Restore(state);
+  episode_.view_index = view_indices[0];
+  BeginEpisode(frame);
+  ProjectCurrentPoints();
+  WriteObservation(observation);
+}
+
+void TrackingEnv::BeginEpisode(int frame) {
+  view_ = observed_views_[0];
   frame_ = frame;
+  const int view_index = episode_.view_index;
   episode_ = EpisodeStats();
   episode_.view_index = view_index;
   episode_.start_frame = frame;
@@ -81,19 +137,42 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
   ProjectCurrentPoints();
   const int num_keypoints =
       simulation_.character().keypoint_layout().num_keypoints();
-  const Keypoint2D* target = view_->frame(frame_);
-  outcome.error = MeasureReprojection(projected_xy_.data(), in_front_.get(),
-                                      target, num_keypoints);
-  ReprojectionError object_error;
-  if (layout_.num_objects > 0) {
-    object_error =
-        MeasureReprojection(projected_xy_.data() + 2 * num_keypoints,
-                            in_front_.get() + num_keypoints,
-                            target + num_keypoints, layout_.num_objects);
+  const int num_points = layout_.num_points;
+  // Per observed view (one in training): keypoint and object errors; the
+  // reward of the views' combined errors.
+  ReprojectionError pose_errors[kMaxObservedViews];
+  ReprojectionError object_errors[kMaxObservedViews];
+  for (int k = 0; k < num_observed_views_; ++k) {
+    const Keypoint2D* target = observed_views_[k]->frame(frame_);
+    const double* projected = projected_xy_.data() + 2 * k * num_points;
+    const bool* in_front = in_front_.get() + k * num_points;
+    pose_errors[k] =
+        MeasureReprojection(projected, in_front, target, num_keypoints);
+    if (layout_.num_objects > 0) {
+      object_errors[k] = MeasureReprojection(
+          projected + 2 * num_keypoints, in_front + num_keypoints,
+          target + num_keypoints, layout_.num_objects);
+    }
   }
-  outcome.terms = ComputeReward(
-      outcome.error, physics.mean_abs_power_w,
-      layout_.num_objects > 0 ? &object_error : nullptr, options_.reward);
+  outcome.error = CombineViewErrors(pose_errors, num_observed_views_);
+  ReprojectionError object_error =
+      CombineViewErrors(object_errors, num_observed_views_);
+  bool off_3d_reference = false;
+  if (options_.target == TrackingTarget::kImage2D) {
+    outcome.terms = ComputeReward(
+        outcome.error, physics.mean_abs_power_w,
+        layout_.num_objects > 0 ? &object_error : nullptr, options_.reward);
+  } else {
+    ReadBodyTarget(simulation_, keypoints_xyz_.data(), &simulated_body_);
+    const Tracking3DError error_3d =
+        MeasureTracking3D(simulated_body_, ReferenceBody(frame_));
+    outcome.terms =
+        ComputeReward3D(error_3d, physics.mean_abs_power_w, options_.reward_3d,
+                        options_.reward.energy_weight);
+    off_3d_reference =
+        options_.reward_3d.early_exit_max_error_m > 0 &&
+        error_3d.max_keypoint_m > options_.reward_3d.early_exit_max_error_m;
+  }
   outcome.reward = static_cast<float>(outcome.terms.total);
 
   episode_.total_reward += outcome.terms.total;
@@ -103,8 +182,9 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
   }
   episode_.max_error_px = std::max(episode_.max_error_px, outcome.error.max_px);
 
-  if (options_.early_exit &&
-      ShouldExitEarly(outcome.error, options_.early_exit_max_error_px)) {
+  if (off_3d_reference ||
+      (options_.early_exit &&
+       ShouldExitEarly(outcome.error, options_.early_exit_max_error_px))) {
     outcome.terminated = true;
     episode_.failed = true;
     return outcome;
@@ -118,28 +198,41 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
 }
 
 void TrackingEnv::ProjectCurrentPoints() {
+  // Outline: the keypoints (and objects) in the world once, then through
+  // each observed view's camera at the current frame.
   const mjData* data = simulation_.data();
   simulation_.KeypointPositions(keypoints_xyz_.data());
-  const PinholeCamera& camera =
-      reference_->bundles()[view_->bundle].views[view_->view].CameraAt(frame_);
   const int num_keypoints = static_cast<int>(keypoints_xyz_.size() / 3);
-  for (int j = 0; j < view_->num_points; ++j) {
-    Eigen::Vector3d point;
-    if (j < num_keypoints) {
-      point = {keypoints_xyz_[3 * j], keypoints_xyz_[3 * j + 1],
-               keypoints_xyz_[3 * j + 2]};
-    } else {
-      const double* xpos =
-          data->xpos + 3 * reference_->object_bodies()[j - num_keypoints];
-      point = {xpos[0], xpos[1], xpos[2]};
+  const int num_points = layout_.num_points;
+  for (int k = 0; k < num_observed_views_; ++k) {
+    const TrackedView& view = *observed_views_[k];
+    const PinholeCamera& camera =
+        reference_->bundles()[view.bundle].views[view.view].CameraAt(frame_);
+    for (int j = 0; j < num_points; ++j) {
+      Eigen::Vector3d point;
+      if (j < num_keypoints) {
+        point = {keypoints_xyz_[3 * j], keypoints_xyz_[3 * j + 1],
+                 keypoints_xyz_[3 * j + 2]};
+      } else {
+        const double* xpos =
+            data->xpos + 3 * reference_->object_bodies()[j - num_keypoints];
+        point = {xpos[0], xpos[1], xpos[2]};
+      }
+      Projection projection = camera.Project(point);
+      const int slot = k * num_points + j;
+      projected_xy_[2 * slot] = projection.pixel_px.x();
+      projected_xy_[2 * slot + 1] = projection.pixel_px.y();
+      in_front_[slot] = projection.in_front;
+      projected_points_[slot] = {projection.pixel_px.x(),
+                                 projection.pixel_px.y(),
+                                 projection.in_front ? 1.0 : 0.0};
     }
-    Projection projection = camera.Project(point);
-    projected_xy_[2 * j] = projection.pixel_px.x();
-    projected_xy_[2 * j + 1] = projection.pixel_px.y();
-    in_front_[j] = projection.in_front;
-    projected_points_[j] = {projection.pixel_px.x(), projection.pixel_px.y(),
-                            projection.in_front ? 1.0 : 0.0};
   }
+}
+
+const BodyTarget3D& TrackingEnv::ReferenceBody(int frame) const {
+  return initial_states_->motion(
+      initial_states_->BufferOf(episode_.view_index))[frame];
 }
 
 void TrackingEnv::ReadBodyKinematics() {
@@ -175,17 +268,42 @@ void TrackingEnv::WriteObservation(float* observation) {
     WriteObjectState(bodies_, object_positions_, object_velocities_,
                      observation + layout_.proprioception_size());
   }
-  // 2D block: the current projection, then L future reference frames, all
-  // in the current reference frame's image normalization.
-  const ImageNormalization& normalization = view_->normalization[frame_];
-  float* out = observation + layout_.view_offset();
-  const int stride = view_->num_points * ObservationLayout::kPointFeatures;
-  WriteNormalizedPoints(projected_points_.data(), view_->num_points,
-                        normalization, out);
-  for (int l = 1; l <= layout_.num_future_frames; ++l) {
-    int future = std::min(frame_ + l, view_->num_frames - 1);
-    WriteNormalizedPoints(view_->frame(future), view_->num_points,
-                          normalization, out + l * stride);
+  const int num_points = layout_.num_points;
+  if (options_.target == TrackingTarget::kBody3D) {
+    // The 3D block: the character's keypoints, then L future reference
+    // frames' keypoints, relative to the character's root and heading.
+    const Eigen::Vector3d& root = bodies_.positions_m[0];
+    const Eigen::Quaterniond to_heading =
+        InverseHeadingRotation(bodies_.orientations[0]);
+    float* out = observation + layout_.view_offset();
+    const int stride = num_points * ObservationLayout::kPointFeatures;
+    for (int j = 0; j < num_points; ++j) {
+      current_points_m_[j] = {keypoints_xyz_[3 * j], keypoints_xyz_[3 * j + 1],
+                              keypoints_xyz_[3 * j + 2]};
+    }
+    WriteRootRelativePoints(current_points_m_.data(), num_points, root,
+                            to_heading, out);
+    for (int l = 1; l <= layout_.num_future_frames; ++l) {
+      const int future = std::min(frame_ + l, view_->num_frames - 1);
+      WriteRootRelativePoints(ReferenceBody(future).keypoints_m.data(),
+                              num_points, root, to_heading, out + l * stride);
+    }
+    return;
+  }
+  // One 2D block per observed view: the current projection, then L future
+  // reference frames, all in the view's current image normalization.
+  const int stride = num_points * ObservationLayout::kPointFeatures;
+  for (int k = 0; k < num_observed_views_; ++k) {
+    const TrackedView& view = *observed_views_[k];
+    const ImageNormalization& normalization = view.normalization[frame_];
+    float* out = observation + layout_.view_offset() + k * layout_.view_size();
+    WriteNormalizedPoints(projected_points_.data() + k * num_points, num_points,
+                          normalization, out);
+    for (int l = 1; l <= layout_.num_future_frames; ++l) {
+      int future = std::min(frame_ + l, view.num_frames - 1);
+      WriteNormalizedPoints(view.frame(future), num_points, normalization,
+                            out + l * stride);
+    }
   }
 }
 

@@ -1,7 +1,9 @@
-// env: the single-view 2D tracking environment. An episode draws a
-// (bundle, view) pair and a start frame, starts from that frame's
-// initial-state buffer, and rewards the character for projecting, through
-// the view's camera, onto the 2D reference. The camera is never observed.
+// env: the 2D tracking environment. An episode draws a (bundle, view) pair
+// and a start frame, starts from that frame's initial-state buffer, and
+// rewards the character for projecting, through the view's camera, onto the
+// 2D reference. The camera is never observed. For zero-shot multi-view
+// tracking an environment observes K views of one bundle at once (one 2D
+// block each; the policy averages phi over them).
 #ifndef MIMIC2D_ENV_TRACKING_ENV_H_
 #define MIMIC2D_ENV_TRACKING_ENV_H_
 
@@ -18,6 +20,25 @@
 
 namespace m2d {
 
+// What an episode's reward follows.
+enum class TrackingTarget {
+  kImage2D,  // the paper's: the 2D reference through the view's camera
+  kBody3D,   // the baselines': a 3D reference, the motion the initial
+             // states were filled from (the 3D truth for 3D-GT, a view's
+             // fitted poses for the two-stage Sfv*), observed as 3D
+             // keypoints relative to the character instead of 2D
+};
+inline const char* SettingName(TrackingTarget target) {
+  return target == TrackingTarget::kImage2D ? "image_2d" : "body_3d";
+}
+inline bool ParseSetting(const std::string& text, TrackingTarget* target) {
+  return ParseSettingByName(
+      text, {TrackingTarget::kImage2D, TrackingTarget::kBody3D}, target);
+}
+inline std::string SettingChoices(TrackingTarget) {
+  return "image_2d, body_3d";
+}
+
 struct TrackingEnvOptions {
   SimulationOptions simulation;
   int num_future_frames = 5;               // L reference frames observed ahead
@@ -25,6 +46,8 @@ struct TrackingEnvOptions {
   bool early_exit = true;                  // reprojection early exit on/off
   double early_exit_max_error_px = 100.0;  // worst-keypoint error that ends it
   RewardWeights reward;
+  TrackingTarget target = TrackingTarget::kImage2D;
+  Body3DRewardWeights reward_3d;  // with target body_3d (energy: reward's)
   // Noisy S.I.: sigma (rad) added once to the joint angles of the
   // initial-state buffers when they are filled; ASI replaces them with
   // visited states. Read by whoever fills the buffers (the Trainer passes it
@@ -50,6 +73,11 @@ struct TrackingEnvOptions {
       "Noisy S.I.: sigma (rad) added once to the joint angles of the "
       "initial-state buffers when they are filled");
     v.Nested("reward", self.reward);
+    v("target", self.target, Range::Any(),
+      "image_2d (the paper's 2D reprojection reward) or body_3d (the "
+      "3D-tracking baselines: a DeepMimic-style reward on the motion the "
+      "initial states come from, 3D keypoints observed instead of 2D)");
+    v.Nested("reward_3d", self.reward_3d);
   }
 
   int max_episode_steps() const {
@@ -86,22 +114,37 @@ struct EpisodeStats {
   }
 };
 
+// Most views one environment observes at once (zero-shot multi-view).
+inline constexpr int kMaxObservedViews = 16;
+
 class TrackingEnv {
  public:
+  // `num_observed_views` (K): 2D blocks per observation; K > 1 episodes
+  // start with ResetToViews.
   TrackingEnv(std::shared_ptr<const Character> character,
               std::shared_ptr<const TrackingReference> reference,
               std::shared_ptr<const InitialStates> initial_states,
-              const TrackingEnvOptions& options, uint64_t seed);
+              const TrackingEnvOptions& options, uint64_t seed,
+              int num_observed_views = 1);
 
   const ObservationLayout& layout() const { return layout_; }
-  int observation_size() const { return layout_.size(); }
+  int num_observed_views() const { return num_observed_views_; }
+  int observation_size() const {
+    return layout_.view_offset() + num_observed_views_ * layout_.view_size();
+  }
   int action_size() const { return simulation_.character().num_actions(); }
 
   // Starts an episode at a random view and frame; writes its observation.
   void Reset(float* observation);
-  // Starts an episode at a given view and frame with a given state.
+  // Starts an episode at a given view and frame with a given state (K = 1).
   void ResetTo(int view_index, int frame, const SimState& state,
                float* observation);
+  // Starts an episode observing K views (indices into
+  // TrackingReference::views(), all of one bundle: the same motion in one
+  // world). The first is the episode's view; a frame fails when any view's
+  // worst keypoint is off, and the error and reward are the views' means.
+  void ResetToViews(const std::vector<int>& view_indices, int frame,
+                    const SimState& state, float* observation);
   // Advances one control period. Writes the next observation unless the
   // episode ended (the caller resets).
   StepOutcome Step(const float* action, float* observation);
@@ -112,17 +155,21 @@ class TrackingEnv {
   const Simulation& simulation() const { return simulation_; }
   Simulation& mutable_simulation() { return simulation_; }
   // The simulated keypoints projected by the episode's camera at the
-  // current frame (x, y per point; valid after Reset/Step).
+  // current frame (x, y per point; valid after Reset/Step); with K views,
+  // the other views' follow in order.
   const std::vector<double>& projected_px() const { return projected_xy_; }
-  // Per point: whether it is in front of the episode's camera.
+  // Per point: whether it is in front of the episode's camera (then the
+  // other views').
   const bool* in_front() const { return in_front_.get(); }
   // Current observation written again (e.g. after the trainer edits state).
   void WriteObservation(float* observation);
 
  private:
-  void BeginEpisode(int view_index, int frame);
+  void BeginEpisode(int frame);
   void ProjectCurrentPoints();
   void ReadBodyKinematics();
+  // Target body_3d: the episode's 3D reference at `frame`.
+  const BodyTarget3D& ReferenceBody(int frame) const;
 
   std::shared_ptr<const TrackingReference> reference_;
   std::shared_ptr<const InitialStates> initial_states_;
@@ -131,17 +178,22 @@ class TrackingEnv {
   ObservationLayout layout_;
   std::mt19937_64 rng_;
 
-  const TrackedView* view_ = nullptr;
+  const int num_observed_views_;
+  // The episode's view first, then the other observed views.
+  std::vector<const TrackedView*> observed_views_;
+  const TrackedView* view_ = nullptr;  // observed_views_[0]
   int frame_ = 0;
   EpisodeStats episode_;
 
-  // Scratch buffers, sized once.
+  // Scratch buffers, sized once (per observed view where projected).
   BodyKinematics bodies_;
   std::vector<double> keypoints_xyz_;
   std::vector<double> projected_xy_;
   std::unique_ptr<bool[]> in_front_;
   std::vector<Keypoint2D> projected_points_;
   std::vector<Eigen::Vector3d> object_positions_, object_velocities_;
+  BodyTarget3D simulated_body_;                    // target body_3d
+  std::vector<Eigen::Vector3d> current_points_m_;  // target body_3d
 };
 
 }  // namespace m2d

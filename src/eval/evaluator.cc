@@ -7,7 +7,34 @@
 #include "eval/metrics.h"
 
 namespace m2d {
-namespace {}  // namespace
+namespace {
+
+// The view sets rolled out: {v} per view for K = 1; otherwise per bundle
+// with at least K views, each view v with the K - 1 next views of its
+// bundle (wrapping).
+std::vector<std::vector<int>> ViewSets(const TrackingReference& reference,
+                                       int num_views) {
+  const std::vector<TrackedView>& views = reference.views();
+  std::vector<std::vector<int>> sets;
+  for (size_t b = 0; b < reference.bundles().size(); ++b) {
+    std::vector<int> bundle_views;
+    for (size_t v = 0; v < views.size(); ++v) {
+      if (views[v].bundle == static_cast<int>(b))
+        bundle_views.push_back(static_cast<int>(v));
+    }
+    const int count = static_cast<int>(bundle_views.size());
+    if (count < num_views) continue;
+    for (int first = 0; first < count; ++first) {
+      std::vector<int> set;
+      for (int k = 0; k < num_views; ++k)
+        set.push_back(bundle_views[(first + k) % count]);
+      sets.push_back(set);
+    }
+  }
+  return sets;
+}
+
+}  // namespace
 
 void EvalOptions::Validate() const {
   if (episodes_per_view < 1)
@@ -15,6 +42,10 @@ void EvalOptions::Validate() const {
   if (!(episode_s > 0)) throw ConfigError("eval: episode_s must be > 0");
   if (!(success_threshold_px > 0))
     throw ConfigError("eval: success_threshold_px must be > 0");
+  if (num_views < 1 || num_views > kMaxObservedViews) {
+    throw ConfigError("eval: the number of views must be in [1, " +
+                      std::to_string(kMaxObservedViews) + "]");
+  }
 }
 
 std::vector<EvalRow> EvaluatePolicy(
@@ -32,6 +63,21 @@ std::vector<EvalRow> EvaluatePolicy(
   }
   // Global positions compare only in the true cameras' world.
   const bool same_world = reference->sources().cameras == CameraSource::kTruth;
+  // K views of one motion must share a world: each view's estimated camera
+  // lives in its own.
+  if (options.num_views > 1 && !same_world) {
+    throw ConfigError(
+        "eval: tracking " + std::to_string(options.num_views) +
+        " views at once needs their cameras in one world: the true cameras "
+        "(a calibrated rig; --cameras truth), not per-view estimates");
+  }
+  const std::vector<std::vector<int>> view_sets =
+      ViewSets(*reference, options.num_views);
+  if (view_sets.empty()) {
+    throw InputError("evaluation", "no bundle has " +
+                                       std::to_string(options.num_views) +
+                                       " views to track at once");
+  }
   // The evaluation episode: early exit exactly at the success threshold.
   // Episodes start from the given initial states (noise-free ones for
   // evaluation: callers build them with sigma 0).
@@ -39,7 +85,11 @@ std::vector<EvalRow> EvaluatePolicy(
   eval_env.early_exit = true;
   eval_env.early_exit_max_error_px = options.success_threshold_px;
   eval_env.max_episode_s = options.episode_s;
-  TrackingEnv env(character, reference, initial_states, eval_env, 0);
+  // Every policy is judged by the same 2D criterion, whatever it was
+  // trained to follow (a 3D baseline's own 3D exit is off).
+  eval_env.reward_3d.early_exit_max_error_m = 0.0;
+  TrackingEnv env(character, reference, initial_states, eval_env, 0,
+                  options.num_views);
   if (env.observation_size() != policy.observation_size() ||
       env.action_size() != policy.action_size()) {
     throw InputError("policy", "expects " +
@@ -56,7 +106,8 @@ std::vector<EvalRow> EvaluatePolicy(
   const KeypointLayout& layout = character->keypoint_layout();
   std::vector<EvalRow> rows;
 
-  for (size_t v = 0; v < reference->views().size(); ++v) {
+  for (const std::vector<int>& view_set : view_sets) {
+    const int v = view_set.front();
     const TrackedView& view = reference->views()[v];
     const ReferenceBundle& bundle = reference->bundles()[view.bundle];
     const GroundTruth3D* bundle_truth =
@@ -66,7 +117,10 @@ std::vector<EvalRow> EvaluatePolicy(
         bundle_truth->layout == &character->keypoint_layout();
     EvalRow row;
     row.bundle = bundle.name;
-    row.view = bundle.views[view.view].name;
+    for (int index : view_set) {
+      if (!row.view.empty()) row.view += "+";
+      row.view += bundle.views[reference->views()[index].view].name;
+    }
     double succ = 0, e2d = 0, eo2d = 0, e3d = 0, e3d_root = 0, e3d_pa = 0,
            jitter = 0, frames = 0;
     // Rollouts that measured anything: one that diverged on its first step
@@ -77,11 +131,10 @@ std::vector<EvalRow> EvaluatePolicy(
       int start = options.episodes_per_view == 1
                       ? 0
                       : last_start * e / (options.episodes_per_view - 1);
-      const StateBuffer& buffer =
-          initial_states->BufferOfView(static_cast<int>(v));
-      env.ResetTo(static_cast<int>(v), start,
-                  buffer.entry(start, buffer.Best(start)).state,
-                  observation.data());
+      const StateBuffer& buffer = initial_states->BufferOfView(v);
+      env.ResetToViews(view_set, start,
+                       buffer.entry(start, buffer.Best(start)).state,
+                       observation.data());
       KeypointFrames simulated, true_keypoints;
       double object_error = 0.0;
       int object_frames = 0;

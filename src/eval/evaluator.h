@@ -19,7 +19,12 @@ struct EvalOptions {
   double episode_s = 10.0;              // episode length (clip end cuts it)
   double success_threshold_px = 100.0;  // a frame whose worst keypoint is off
                                         // by more fails the rollout
-  void Validate() const;                // throws ConfigError
+  // K: views observed at once (zero-shot multi-view tracking, phi averaged
+  // over them). K > 1 evaluates, for every bundle with at least K views and
+  // each of its views in turn, that view with the K - 1 next ones (in the
+  // bundle's order, wrapping); it needs the true cameras (one world).
+  int num_views = 1;
+  void Validate() const;  // throws ConfigError
 };
 
 // One evaluation rollout (to find which start fails).
@@ -32,10 +37,11 @@ struct EvalRollout {
 
 struct EvalRow {
   std::string bundle;
-  std::string view;
+  std::string view;  // with K views: their names joined by '+'
   int episodes = 0;
-  // Fraction of successful rollouts: no frame over the threshold, and at
-  // least half of the frames had reference keypoints to judge them by.
+  // Fraction of successful rollouts: no frame over the threshold (in any of
+  // the K views), and at least half of the frames had reference keypoints
+  // to judge them by. E2D: over the K views, their mean.
   double succ = 0.0;
   // Mean per-frame mean 2D error (until failure) over the frames that had
   // reference keypoints; -1 when no rollout measured any (e.g. every start

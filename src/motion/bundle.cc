@@ -458,8 +458,9 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
                                      const BundleFromMotionOptions& options,
                                      const std::string& name) {
   // Outline: loop/resample the motion to the clip rate, run FK for the 3D
-  // keypoints, place the rig at the start root, project per view (moving
-  // the camera with the subject when following), add detector noise.
+  // keypoints, place the rig at the start root (or the path's middle), project
+  // per view (moving the camera with the subject when following), add detector
+  // noise.
   options.Validate();
   Motion3D sampled = ExtendLoop(motion, options.duration_s);
   sampled = ResampleMotion(sampled, options.fps);
@@ -484,8 +485,11 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
   truth.poses = sampled.frames;
 
   RigOptions rig = options.rig;
-  Eigen::Vector3d start = sampled.frames.front().root_position_m;
-  rig.target_m += Eigen::Vector3d(start.x(), start.y(), 0.0);
+  Eigen::Vector3d aim = sampled.frames.front().root_position_m;
+  if (options.aim == RigAim::kPathMiddle) {
+    aim = 0.5 * (aim + sampled.frames.back().root_position_m);
+  }
+  rig.target_m += Eigen::Vector3d(aim.x(), aim.y(), 0.0);
   std::vector<NamedCamera> base_cameras = MakeRig(rig);
   std::vector<Eigen::Vector3d> path;
   if (options.follow == CameraFollow::kRootDolly) {

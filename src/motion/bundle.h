@@ -124,10 +124,18 @@ enum class CameraFollow {
   kRootDolly,  // cameras translate with the subject's smoothed ground path
 };
 
+// Where the rig's target sits on the ground (rig.target_m is relative to it).
+enum class RigAim {
+  kStartRoot,   // the subject's first root position
+  kPathMiddle,  // midway between the first and last root: static cameras
+                // keep a subject that travels in view and away from the lens
+};
+
 struct BundleFromMotionOptions {
   double fps = 30.0;        // frame rate of the 2D clips
   double duration_s = 0.0;  // > motion length: loop a looping motion
-  RigOptions rig;           // rig.target_m is relative to the start root
+  RigOptions rig;           // rig.target_m is relative to `aim`
+  RigAim aim = RigAim::kStartRoot;
   CameraFollow follow = CameraFollow::kStatic;
   double follow_smoothing_s = 1.0;  // window of the dolly's moving average
   DetectorNoiseOptions noise;

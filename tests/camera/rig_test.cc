@@ -39,6 +39,30 @@ TEST(Rig, ViewsCircleTheTargetAtTheGivenDistanceAndElevation) {
               1e-9);
 }
 
+// An AIST++-like rig: the views differ in elevation and range as well.
+TEST(Rig, SpansSpreadElevationAndDistanceOverTheViews) {
+  RigOptions options;
+  options.num_views = 4;
+  options.elevation_deg = 30;
+  options.elevation_span_deg = -30;
+  options.distance_m = 3.5;
+  options.distance_span_m = 2.5;
+  std::vector<NamedCamera> rig = MakeRig(options);
+  const double elevations[] = {30, 20, 10, 0};
+  const double distances[] = {3.5, 3.5 + 2.5 / 3, 3.5 + 5.0 / 3, 6.0};
+  for (int k = 0; k < 4; ++k) {
+    Eigen::Vector3d offset = rig[k].camera.CenterWorld() - options.target_m;
+    EXPECT_NEAR(offset.norm(), distances[k], 1e-9);
+    EXPECT_NEAR(std::asin(offset.z() / offset.norm()) * 180 / M_PI,
+                elevations[k], 1e-9);
+  }
+  options.elevation_span_deg = 60;  // the last view at 90 degrees
+  EXPECT_THROW(MakeRig(options), ConfigError);
+  options.elevation_span_deg = 0;
+  options.distance_span_m = -3.45;  // the last view 5 cm from the target
+  EXPECT_THROW(MakeRig(options), ConfigError);
+}
+
 TEST(Rig, ValidateRejectsBadSettings) {
   RigOptions options;
   options.num_views = 0;

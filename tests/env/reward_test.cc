@@ -83,5 +83,88 @@ TEST(Reward, WeightsAreValidated) {
   EXPECT_THROW(weights.Validate(), ConfigError);
 }
 
+// K views as one: the worst keypoint of any view fails the frame; the mean
+// error is the mean of the views that saw keypoints.
+TEST(Reprojection, ViewsCombineWorstOfMaxAndMeanOfMeans) {
+  ReprojectionError errors[3];
+  errors[0].mean_px = 10;
+  errors[0].weighted_sum_px = 170;
+  errors[0].max_px = 30;
+  errors[0].num_present = 17;
+  errors[1].mean_px = 20;
+  errors[1].weighted_sum_px = 340;
+  errors[1].max_px = 120;
+  errors[1].num_present = 17;
+  errors[2].num_present = 0;  // no keypoints in this view this frame
+  ReprojectionError combined = CombineViewErrors(errors, 3);
+  EXPECT_DOUBLE_EQ(combined.mean_px, 15.0);
+  EXPECT_DOUBLE_EQ(combined.weighted_sum_px, 255.0);
+  EXPECT_DOUBLE_EQ(combined.max_px, 120.0);
+  EXPECT_EQ(combined.num_present, 34);
+  EXPECT_TRUE(ShouldExitEarly(combined, 100.0));
+  ReprojectionError single = CombineViewErrors(errors, 1);
+  EXPECT_DOUBLE_EQ(single.max_px, 30.0);
+  EXPECT_EQ(single.num_present, 17);
+}
+
+BodyTarget3D TwoHingeBody() {
+  BodyTarget3D body;
+  body.root_position_m = {1, 2, 0.9};
+  body.hinge_angles_rad = {0.1, -0.2};
+  body.hinge_velocities_rad_s = {1.0, 0.5};
+  body.keypoints_m = {{1, 2, 1.6}, {1.2, 2, 0.1}};
+  return body;
+}
+
+TEST(Tracking3D, AStateOnItsReferenceEarnsEveryWeight) {
+  const BodyTarget3D body = TwoHingeBody();
+  Tracking3DError error = MeasureTracking3D(body, body);
+  EXPECT_DOUBLE_EQ(error.max_keypoint_m, 0.0);
+  Body3DRewardWeights weights;
+  RewardTerms terms = ComputeReward3D(error, 0.0, weights, 1e-4);
+  EXPECT_NEAR(terms.total, 0.5 + 0.1 + 0.15 + 0.1 + 0.15, 1e-12);
+}
+
+TEST(Tracking3D, EachErrorLowersItsTermAsDeepMimicsExponentials) {
+  const BodyTarget3D reference = TwoHingeBody();
+  Body3DRewardWeights weights;
+  // Hinge angles 0.3 rad off in both: the pose term is 0.5 exp(-2 * 0.18).
+  BodyTarget3D bent = reference;
+  bent.hinge_angles_rad[0] += 0.3;
+  bent.hinge_angles_rad[1] -= 0.3;
+  Tracking3DError error = MeasureTracking3D(bent, reference);
+  EXPECT_NEAR(error.hinge_sq_rad2, 0.18, 1e-12);
+  EXPECT_NEAR(ComputeReward3D(error, 0.0, weights, 0.0).total,
+              0.5 * std::exp(-0.36) + 0.5, 1e-12);
+  // The whole body 0.2 m to the side: the root term drops, the
+  // root-relative keypoint term does not, the worst keypoint is 0.2 m off.
+  BodyTarget3D moved = reference;
+  moved.root_position_m.x() += 0.2;
+  for (Eigen::Vector3d& k : moved.keypoints_m) k.x() += 0.2;
+  error = MeasureTracking3D(moved, reference);
+  EXPECT_NEAR(error.keypoint_local_sq_m2, 0.0, 1e-12);
+  EXPECT_NEAR(error.max_keypoint_m, 0.2, 1e-12);
+  EXPECT_NEAR(error.mean_keypoint_m, 0.2, 1e-12);
+  EXPECT_NEAR(ComputeReward3D(error, 0.0, weights, 0.0).total,
+              0.85 + 0.15 * std::exp(-5.0 * 0.04), 1e-12);
+  // A turned root: 0.5 rad about z costs 0.1 * 0.25 inside the root term.
+  BodyTarget3D turned = reference;
+  turned.root_orientation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+  error = MeasureTracking3D(turned, reference);
+  EXPECT_NEAR(error.root_rotation_sq_rad2, 0.25, 1e-12);
+  // Energy: the same penalty as the 2D reward's.
+  EXPECT_NEAR(ComputeReward3D(MeasureTracking3D(reference, reference), 200.0,
+                              weights, 1e-4)
+                  .total,
+              1.0 - 0.02, 1e-12);
+}
+
+TEST(Tracking3D, BadWeightsAreRejected) {
+  Body3DRewardWeights weights;
+  weights.pose_scale = -1;
+  EXPECT_THROW(weights.Validate(), ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d

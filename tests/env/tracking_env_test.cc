@@ -229,5 +229,101 @@ TEST(TrackingEnv, BundleAtTheWrongRateIsRejected) {
                InputError);
 }
 
+// Zero-shot multi-view: an environment observing views {1, 2} writes the
+// proprioception once and then each view's block exactly as a one-view
+// environment on that view would; a frame's worst error is the worse view's.
+TEST(TrackingEnv, KViewsAreObservedAsTheirOneViewBlocksSideBySide) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  TrackingEnv both(task.character, task.reference, task.initial_states,
+                   task.options, 1, 2);
+  TrackingEnv first(task.character, task.reference, task.initial_states,
+                    task.options, 1);
+  TrackingEnv second(task.character, task.reference, task.initial_states,
+                     task.options, 1);
+  const ObservationLayout& layout = first.layout();
+  ASSERT_EQ(both.observation_size(),
+            layout.view_offset() + 2 * layout.view_size());
+  std::vector<float> obs_both(both.observation_size()),
+      obs_first(first.observation_size()),
+      obs_second(second.observation_size());
+  std::vector<float> action(first.action_size());
+  const SimState& start = task.initial_states->buffer(0).entry(5, 0).state;
+  both.ResetToViews({1, 2}, 5, start, obs_both.data());
+  first.ResetTo(1, 5, start, obs_first.data());
+  second.ResetTo(2, 5, start, obs_second.data());
+  for (int step = 0; step < 8; ++step) {
+    const int base = layout.view_offset(), block = layout.view_size();
+    for (int i = 0; i < base + block; ++i)
+      ASSERT_EQ(obs_both[i], obs_first[i]) << "step " << step << ", " << i;
+    for (int i = 0; i < block; ++i) {
+      ASSERT_EQ(obs_both[base + block + i], obs_second[base + i])
+          << "step " << step << ", " << i;
+    }
+    for (size_t i = 0; i < action.size(); ++i)
+      action[i] = 0.1f * std::sin(0.3f * i + step);
+    StepOutcome a = both.Step(action.data(), obs_both.data());
+    StepOutcome b = first.Step(action.data(), obs_first.data());
+    StepOutcome c = second.Step(action.data(), obs_second.data());
+    EXPECT_DOUBLE_EQ(a.error.max_px, std::max(b.error.max_px, c.error.max_px));
+    EXPECT_NEAR(a.error.mean_px, 0.5 * (b.error.mean_px + c.error.mean_px),
+                1e-9);
+    if (a.terminated || a.truncated) break;
+  }
+  // K views must be views of one bundle, and as many as the env observes.
+  EXPECT_THROW(both.ResetToViews({1}, 5, start, obs_both.data()), ConfigError);
+  EXPECT_THROW(both.ResetTo(1, 5, start, obs_both.data()), ConfigError);
+}
+
+// The 3D baselines' target: from the reference's own state the character is
+// on its 3D reference (every reward term near its weight), observes its own
+// and the reference's keypoints relative to its root, and a character that
+// stands while the reference walks away ends by the 3D exit.
+TEST(TrackingEnv, ABody3DTargetFollowsTheInitialStatesMotion) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 3.0);
+  TrackingEnvOptions options = task.options;
+  options.target = TrackingTarget::kBody3D;
+  options.early_exit = false;  // the 2D exit off: only the 3D one
+  TrackingEnv env(task.character, task.reference, task.initial_states, options,
+                  1);
+  std::vector<float> observation(env.observation_size());
+  const int frame = 10;
+  const std::vector<BodyTarget3D>& motion = task.initial_states->motion(0);
+  env.ResetTo(0, frame, *task.initial_states->buffer(0).anchor(frame),
+              observation.data());
+  // The current block is the character's keypoints, the l = 1 block the
+  // reference's next frame, both about the character's root and heading.
+  const ObservationLayout& layout = env.layout();
+  const Eigen::Vector3d root = motion[frame].root_position_m;
+  const Eigen::Quaterniond to_heading =
+      InverseHeadingRotation(motion[frame].root_orientation);
+  std::vector<float> expected(layout.view_size());
+  WriteRootRelativePoints(motion[frame].keypoints_m.data(), 17, root,
+                          to_heading, expected.data());
+  WriteRootRelativePoints(motion[frame + 1].keypoints_m.data(), 17, root,
+                          to_heading, expected.data() + 17 * 3);
+  for (int i = 0; i < 2 * 17 * 3; ++i)
+    EXPECT_NEAR(observation[layout.view_offset() + i], expected[i], 1e-5) << i;
+
+  // Zero actions (PD targets mid-range): the first step is still close to
+  // the reference; then the walker leaves the stander behind.
+  std::vector<float> action(env.action_size(), 0.0f);
+  StepOutcome outcome = env.Step(action.data(), observation.data());
+  EXPECT_GT(outcome.terms.pose, 0.5);
+  int steps = 1;
+  while (!outcome.terminated && !outcome.truncated) {
+    outcome = env.Step(action.data(), observation.data());
+    ++steps;
+  }
+  EXPECT_TRUE(outcome.terminated);
+  EXPECT_LT(steps, 60);
+
+  // No 3D reference from a placed default pose; no objects or K views.
+  EXPECT_THROW(TrackingEnv(task.character, task.reference, task.initial_states,
+                           options, 1, 2),
+               ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d

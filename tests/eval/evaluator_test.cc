@@ -230,5 +230,63 @@ TEST(EvaluatePolicy, InvalidOptionsAreRejected) {
                ConfigError);
 }
 
+// Zero-shot multi-view: K = 3 rolls each of the walk's 4 views out with the
+// two next ones, named together; with a policy that ignores what it sees,
+// the 3D outcome equals the one-view evaluation's from the same starts. A
+// view set needs one world: per-view estimated cameras are refused.
+TEST(EvaluatePolicy, KViewsAreRolledOutTogetherInTheTrueCamerasWorld) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  EvalOptions options;
+  options.episodes_per_view = 2;
+  options.episode_s = 0.5;
+  options.success_threshold_px = 1e6;
+  ZeroPolicy one_view = MakeZeroPolicy(task);
+  std::vector<EvalRow> single = EvaluatePolicy(
+      one_view, task.character, task.reference, task.initial_states,
+      task.options, options, {task.reference->bundles()[0].ground_truth});
+  options.num_views = 3;
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 0, 3);
+  ZeroPolicy three_views(env.observation_size(), env.action_size());
+  std::vector<EvalRow> rows = EvaluatePolicy(
+      three_views, task.character, task.reference, task.initial_states,
+      task.options, options, {task.reference->bundles()[0].ground_truth});
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0].view, "view0+view1+view2");
+  EXPECT_EQ(rows[3].view, "view3+view0+view1");
+  for (size_t v = 0; v < rows.size(); ++v) {
+    EXPECT_EQ(rows[v].succ, 1.0);
+    EXPECT_DOUBLE_EQ(rows[v].e3d_mm, single[v].e3d_mm);
+    EXPECT_TRUE(std::isfinite(rows[v].e2d_px));
+  }
+  // The policy must take K blocks; more views than a bundle has: nothing.
+  EXPECT_THROW(EvaluatePolicy(one_view, task.character, task.reference,
+                              task.initial_states, task.options, options),
+               InputError);
+  options.num_views = 5;
+  EXPECT_THROW(EvaluatePolicy(three_views, task.character, task.reference,
+                              task.initial_states, task.options, options),
+               InputError);
+
+  TrackingEnvOptions env_options;
+  auto character = testing::LoadHumanoid(env_options.simulation);
+  ReferenceBundle bundle = testing::MakeGlidingBundle(*character, 1.0);
+  bundle.estimate = testing::EstimateFromTruth(
+      bundle, {{1.2, {2.0, 1.0, 0.0}}, {-0.5, {-1.0, 0.5, 0.0}}});
+  TrackingTaskOptions task_options;
+  task_options.simulation = env_options.simulation;
+  task_options.sources = {InitialStateSource::kEstimate,
+                          CameraSource::kEstimate};
+  TrackingTask estimated = BuildTrackingTask(character, {bundle}, task_options);
+  TrackingEnv pair_env(estimated.character, estimated.reference,
+                       estimated.initial_states, env_options, 0, 2);
+  ZeroPolicy pair(pair_env.observation_size(), pair_env.action_size());
+  options.num_views = 2;
+  EXPECT_THROW(EvaluatePolicy(pair, estimated.character, estimated.reference,
+                              estimated.initial_states, env_options, options),
+               ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d

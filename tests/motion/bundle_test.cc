@@ -88,6 +88,37 @@ TEST(Bundle, LoopedFollowedWalkStaysInFrame) {
   }
 }
 
+// Static cameras aimed midway along the path: a walker starts as far
+// before the rig's target as it ends past it.
+TEST(Bundle, AimingAtThePathsMiddleCentresATravellingSubject) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  WalkFixture walk = LoadWalk(path);
+  BundleFromMotionOptions options;
+  options.duration_s = 3.0;
+  options.rig.num_views = 1;
+  options.rig.first_azimuth_deg = 90;  // looking along -y at the target
+  options.aim = RigAim::kPathMiddle;
+  ReferenceBundle bundle =
+      MakeBundleFromMotion(walk.motion, walk.map, options, "walk");
+  const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
+  const Eigen::Vector3d start = poses.front().root_position_m;
+  const Eigen::Vector3d end = poses.back().root_position_m;
+  ASSERT_GT((end - start).head<2>().norm(), 2.0);  // it travels
+  Eigen::Vector3d centre = bundle.views[0].CameraAt(0).CenterWorld();
+  Eigen::Vector3d middle = 0.5 * (start + end);
+  EXPECT_NEAR(centre.x(), middle.x(), 1e-9);
+  EXPECT_NEAR(centre.y() - options.rig.distance_m *
+                               std::cos(options.rig.elevation_deg * M_PI / 180),
+              middle.y(), 1e-9);
+  // From the start root instead, the camera stands beside the first frame.
+  options.aim = RigAim::kStartRoot;
+  centre = MakeBundleFromMotion(walk.motion, walk.map, options, "walk")
+               .views[0]
+               .CameraAt(0)
+               .CenterWorld();
+  EXPECT_NEAR(centre.x(), start.x(), 1e-9);
+}
+
 TEST(Bundle, DetectorNoiseIsSeededAndHasTheRequestedStatistics) {
   M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
   WalkFixture walk = LoadWalk(path);

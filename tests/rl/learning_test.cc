@@ -81,12 +81,16 @@ BeforeAndAfter EvaluateBeforeAndAfter(
 struct LearningThresholds {
   double min_survival_gain;
   double min_trained_frames;
+  // E2D averages the frames a rollout survived: a 3D tracker that survives
+  // into the walk's harder frames need not lower it (the 2D trackers do).
+  bool e2d_must_fall = true;
 };
 
 void ExpectTheWalkIsLearned(
     const std::string& name, bool overlap_update, TrainingPrecision precision,
     const LearningThresholds& thresholds,
-    CollectionMode collection = CollectionMode::kBatched) {
+    CollectionMode collection = CollectionMode::kBatched,
+    TrackingTarget target = TrackingTarget::kImage2D) {
   const std::string walk_path =
       testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt");
   std::string dir = testing::TempDir(name);
@@ -104,6 +108,9 @@ void ExpectTheWalkIsLearned(
   config.ppo.overlap_update = overlap_update;
   config.ppo.training_precision = precision;
   config.ppo.collection = collection;
+  config.env.target = target;
+  // A 3D tracker ends its training episodes by its own 3D exit.
+  if (target == TrackingTarget::kBody3D) config.env.early_exit = false;
   UseCiSizedLearning(dir, &config);
 
   Trainer trainer(config, /*resume=*/false);
@@ -128,7 +135,7 @@ void ExpectTheWalkIsLearned(
   EXPECT_GT(after.mean_frames,
             before.mean_frames * thresholds.min_survival_gain);
   EXPECT_GT(after.mean_frames, thresholds.min_trained_frames);
-  EXPECT_LT(after.e2d_px, before.e2d_px);
+  if (thresholds.e2d_must_fall) EXPECT_LT(after.e2d_px, before.e2d_px);
 }
 
 TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
@@ -170,6 +177,20 @@ TEST(Learning, ABf16UpdateLearnsTheWalk) {
 // 21.8 frames and 21.4 px batched at the same seed and samples.
 constexpr double kMinPerThreadSurvivalGain = 1.6;    // measured 2.25x
 constexpr double kMinPerThreadTrainedFrames = 18.0;  // measured 23.9
+// The 3D-supervised baseline's task (env.target: body_3d): the same walk,
+// followed in 3D from its truth with a DeepMimic-style reward, judged by
+// the same 2D evaluation as the 2D tracker. Measured 2026-11-24 at the same
+// seed and samples (51 s with a training on the other core): frames tracked
+// before the 100 px exit 10.5 -> 22.9 (2.2x), E2D 26.9 -> 28.1 px over
+// those longer rollouts.
+TEST(Learning, A3dTrackerLearnsTheWalkFromItsTruth) {
+  ExpectTheWalkIsLearned("learning_3d", /*overlap_update=*/false,
+                         TrainingPrecision::kFp32,
+                         {kMinSurvivalGain, kMinTrainedFrames,
+                          /*e2d_must_fall=*/false},
+                         CollectionMode::kBatched, TrackingTarget::kBody3D);
+}
+
 TEST(Learning, PerThreadCollectionLearnsTheWalk) {
   ExpectTheWalkIsLearned(
       "learning_per_thread", /*overlap_update=*/false, TrainingPrecision::kFp32,

@@ -1,0 +1,73 @@
+#!/bin/bash
+# The paper's main table on our data (issue 14, docs/results.md), from
+# trained checkpoints: rows 3D-GT / ours 1 view (from 2D) / ours 1, 2, 3
+# views (true cameras) / Sfv*; columns Succ, E2D, E3D global, root-relative
+# and Procrustes-aligned, Jitter; on the training clips and the unseen ones,
+# clean and noisy 2D.
+#
+#   bench/dataset_table.sh [DATASET_DIR] [OUT_DIR]
+#       (defaults runs/dataset, runs/dataset_table)
+#
+# Needs scripts/make_dataset.sh's bundles and the checkpoints of
+# configs/dataset2d.yaml, dataset3d_gt.yaml and dataset_sfv.yaml (a missing
+# checkpoint's rows are skipped and say so). Every rollout starts at a
+# clip's first frame and runs to its end (clips are 0.8-4.4 s): one rollout
+# per view. Prints a Markdown table; every row's eval JSON goes to OUT_DIR.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+data=${1:-runs/dataset}
+out=${2:-runs/dataset_table}
+bin=build/mimic2d
+mkdir -p "$out"
+
+train_clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"
+# The unseen clips the fit could estimate (scripts/make_dataset.sh leaves
+# out the crawl and the get-up: their fits do not converge).
+unseen_clips="dance_spin roll"
+
+ours=runs/dataset2d/checkpoint.pt
+gt=runs/dataset3d_gt/checkpoint.pt
+sfv=runs/dataset_sfv/checkpoint.pt
+
+# bundles SPLIT SUFFIX: --bundle flags for the split's clips.
+bundles() {
+  local clips=$train_clips
+  [ "$1" = unseen ] && clips=$unseen_clips
+  for clip in $clips; do printf -- "--bundle %s/%s%s.json " "$data" "$clip" "$2"; done
+}
+
+# row NAME CHECKPOINT SPLIT NOISE SUFFIX [EVAL FLAGS...]: one table row.
+row() {
+  local name=$1 checkpoint=$2 split=$3 noise=$4 suffix=$5
+  shift 5
+  local tag
+  tag=$(echo "$name-$split-$noise" | tr ' ,*' '___')
+  if [ ! -f "$checkpoint" ]; then
+    echo "| $name | $split | $noise | (no checkpoint $checkpoint) | | | | | |"
+    return
+  fi
+  local noisy=""
+  [ "$noise" = noisy ] && noisy=_noisy
+  # shellcheck disable=SC2046
+  $bin eval "$checkpoint" $(bundles "$split" "$noisy$suffix") \
+    --episodes 1 --episode-s 10 "$@" -o "$out/$tag.json" > "$out/$tag.txt"
+  # The "all" line: clip view eps frames Succ% E2D EO2D E3D E3Droot E3DPA Jitter.
+  awk -v name="$name" -v split="$split" -v noise="$noise" '
+    $1 == "all" { printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
+                  name, split, noise, $5, $6, $8, $9, $10, $11 }' \
+    "$out/$tag.txt"
+}
+
+echo "| method | clips | 2D | Succ % | E2D (px) | E3D (mm) | E3D root-rel. (mm) | PA-MPJPE (mm) | Jitter (10^3 m/s^3) |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for split in train unseen; do
+  for noise in clean noisy; do
+    row "3D-GT (truth starts, true cameras)" "$gt" "$split" "$noise" _truth
+    row "ours, 1 view, from 2D (fit's starts and cameras)" "$ours" "$split" "$noise" ""
+    for views in 1 2 3; do
+      row "ours, $views view(s), truth starts, true cameras" "$ours" "$split" "$noise" _truth \
+        --starts truth --cameras truth --views "$views"
+    done
+    row "Sfv* w/ our fit (fit's starts and cameras)" "$sfv" "$split" "$noise" ""
+  done
+done

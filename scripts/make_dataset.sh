@@ -1,0 +1,68 @@
+#!/bin/bash
+# The dataset of issue 14 (docs/results.md): DeepMimic humanoid clips, each
+# seen by an AIST++-like rig of 4 static cameras (1920x1080, focal 1400 px,
+# elevations 0-30 deg, 3.5-6 m away, the azimuths turned per clip), then
+# stripped to their 2D and fitted view by view: what a user with four
+# calibrated videos per clip has (the intrinsics known, `--focal`).
+#
+#   scripts/make_dataset.sh [OUT_DIR]   (default runs/dataset)
+#
+# Writes OUT_DIR/<clip>_truth.json (the measurement's side: eval reads its
+# ground truth for E3D only), <clip>_2d.json (stripped) and <clip>.json (the
+# fit's estimate; what training and eval read), and the same with detector
+# noise (Gaussian 4 px, 5 % of keypoints dropped, seed 11) as
+# <clip>_noisy_truth.json, _noisy_2d.json, _noisy.json. A clip the fit
+# cannot estimate (more than a quarter of a view's frames unconverged, e.g.
+# the crawl) is reported and left out. Clips come from
+# $MIMIC2D_SHARED_DATA (default ../shared/data)/deepmimic/motions.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-runs/dataset}
+shared=${MIMIC2D_SHARED_DATA:-../shared/data}
+motions="$shared/deepmimic/motions"
+bin=build/mimic2d
+mkdir -p "$out"
+
+train_clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"
+unseen_clips="crawl dance_spin roll getup_faceup"
+
+make_one() {  # clip index [noisy]
+  local clip=$1 index=$2 noise=() name=$1
+  if [ "${3:-}" = noisy ]; then
+    noise=(--noise-px 4 --drop 0.05 --seed 11)
+    name=${clip}_noisy
+  fi
+  local motion="$motions/humanoid3d_$clip.txt"
+  [ -f "$motion" ] || { echo "make_dataset: $motion not found" >&2; return 1; }
+  # Odd clips put the high camera close and the low one far.
+  local elevation=0 elevation_span=30
+  if (( index % 2 )); then elevation=30; elevation_span=-30; fi
+  local azimuth=$(( (index * 37) % 360 ))
+  if [ ! -f "$out/${name}_2d.json" ]; then
+    $bin clip from-motion "$motion" --views 4 --first-azimuth "$azimuth" \
+      --elevation "$elevation" --elevation-span "$elevation_span" \
+      --distance 3.5 --distance-span 2.5 --focal 1400 --aim middle \
+      "${noise[@]}" -o "$out/${name}_truth.json" > /dev/null
+    $bin clip strip "$out/${name}_truth.json" -o "$out/${name}_2d.json" \
+      > /dev/null
+    if $bin fit "$out/${name}_2d.json" --camera static --focal 1400 --quiet \
+      -o "$out/${name}.json" > "$out/${name}_fit.log" 2>&1; then
+      echo "fitted $name"
+    else
+      echo "left out $name: $(tail -n 1 "$out/${name}_fit.log")"
+    fi
+  fi
+}
+
+# Two fits at a time (one solver thread each).
+jobs_started=0
+for variant in clean noisy; do
+  index=0
+  for clip in $train_clips $unseen_clips; do
+    make_one "$clip" "$index" "$variant" &
+    index=$((index + 1))
+    jobs_started=$((jobs_started + 1))
+    if (( jobs_started % 2 == 0 )); then wait; fi
+  done
+done
+wait
