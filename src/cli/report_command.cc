@@ -5,7 +5,7 @@
 
 #include "cli/commands.h"
 #include "render/report.h"
-#include "render/subprocess.h"
+#include "media/subprocess.h"
 #include "render/training_plot.h"
 
 namespace m2d::cli {

@@ -14,9 +14,9 @@
 #include "motion/bundle.h"
 #include "motion/clip2d.h"
 #include "render/gl_camera.h"
-#include "render/image.h"
+#include "media/image.h"
 #include "render/scene_renderer.h"
-#include "render/video_writer.h"
+#include "media/video_writer.h"
 #include "sim/simulation.h"
 
 namespace m2d {

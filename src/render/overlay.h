@@ -8,8 +8,8 @@
 
 #include "motion/clip2d.h"
 #include "motion/layout.h"
-#include "render/cairo_bridge.h"
-#include "render/image.h"
+#include "media/cairo_bridge.h"
+#include "media/image.h"
 
 namespace m2d {
 

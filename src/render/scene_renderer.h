@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "camera/pinhole.h"
-#include "render/image.h"
+#include "media/image.h"
 #include "sim/mujoco_handles.h"
 
 namespace m2d {

@@ -11,7 +11,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
-#include "render/subprocess.h"
+#include "media/subprocess.h"
 
 namespace m2d {
 namespace {

@@ -7,8 +7,8 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
-#include "render/image.h"
-#include "render/video_writer.h"
+#include "media/image.h"
+#include "media/video_writer.h"
 #include "render_test_util.h"
 
 namespace m2d {

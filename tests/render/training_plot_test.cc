@@ -7,7 +7,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
-#include "render/image.h"
+#include "media/image.h"
 #include "render_test_util.h"
 
 namespace m2d {

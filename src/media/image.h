@@ -1,7 +1,8 @@
-// render: what happened, shown — offscreen MuJoCo video from a reference
-// camera with 2D keypoint overlays, training plots and HTML reports.
-#ifndef MIMIC2D_RENDER_IMAGE_H_
-#define MIMIC2D_RENDER_IMAGE_H_
+// media: images and video in and out — RGB images, PNG, video decoding and
+// MP4 encoding through the ffmpeg binary, child processes; shared by
+// rendering and detection.
+#ifndef MIMIC2D_MEDIA_IMAGE_H_
+#define MIMIC2D_MEDIA_IMAGE_H_
 
 #include <cstdint>
 #include <string>
@@ -53,4 +54,4 @@ RgbImage ReadPng(const std::string& path);
 
 }  // namespace m2d
 
-#endif  // MIMIC2D_RENDER_IMAGE_H_
+#endif  // MIMIC2D_MEDIA_IMAGE_H_

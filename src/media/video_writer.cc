@@ -1,4 +1,4 @@
-#include "render/video_writer.h"
+#include "media/video_writer.h"
 
 #include <unistd.h>
 

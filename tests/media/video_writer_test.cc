@@ -1,4 +1,4 @@
-#include "render/video_writer.h"
+#include "media/video_writer.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
-#include "render_test_util.h"
+#include "media/media_test_util.h"
 
 namespace m2d {
 namespace {

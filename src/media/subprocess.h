@@ -1,7 +1,8 @@
-// render: what happened, shown — offscreen MuJoCo video from a reference
-// camera with 2D keypoint overlays, training plots and HTML reports.
-#ifndef MIMIC2D_RENDER_SUBPROCESS_H_
-#define MIMIC2D_RENDER_SUBPROCESS_H_
+// media: images and video in and out — RGB images, PNG, video decoding and
+// MP4 encoding through the ffmpeg binary, child processes; shared by
+// rendering and detection.
+#ifndef MIMIC2D_MEDIA_SUBPROCESS_H_
+#define MIMIC2D_MEDIA_SUBPROCESS_H_
 
 #include <sys/types.h>
 
@@ -17,13 +18,21 @@ struct ProcessResult {
   bool ok() const { return exit_code == 0; }
 };
 
+// Which of the child's streams the pipe is.
+enum class PipeDirection {
+  kToChild,    // we write its stdin; its stdout and stderr go to the file
+  kFromChild,  // we read its stdout; its stdin is empty, stderr to the file
+};
+
 // A child process started without a shell (argv[0] is looked up in PATH),
-// fed through a pipe on its stdin. Its stdout and stderr go to a temporary
-// file (so a chatty child never blocks), read back by Wait().
+// fed through a pipe on its stdin or read through one on its stdout. What
+// else it prints goes to a temporary file (so a chatty child never
+// blocks), read back by Wait().
 class PipedProcess {
  public:
   // Throws std::runtime_error naming argv[0] when it cannot be started.
-  explicit PipedProcess(const std::vector<std::string>& argv);
+  explicit PipedProcess(const std::vector<std::string>& argv,
+                        PipeDirection direction = PipeDirection::kToChild);
   // Stops a child that was not waited for (SIGTERM) and reaps it.
   ~PipedProcess();
   PipedProcess(const PipedProcess&) = delete;
@@ -32,12 +41,16 @@ class PipedProcess {
   // Writes all `size` bytes; false when the child closed its input (it
   // exited; Wait() tells why). Never raises SIGPIPE.
   bool Write(const void* bytes, size_t size);
+  // kFromChild: reads until `size` bytes or the end of the child's output;
+  // returns how many were read.
+  size_t Read(void* bytes, size_t size);
   // Closes the child's stdin and waits for it to exit.
   ProcessResult Wait();
 
  private:
   pid_t pid_ = -1;
-  int stdin_fd_ = -1;
+  int stdin_fd_ = -1;   // kToChild: the write end of the child's stdin
+  int stdout_fd_ = -1;  // kFromChild: the read end of the child's stdout
   std::string output_path_;
 };
 
@@ -63,4 +76,4 @@ class ScopedTempFolder {
 
 }  // namespace m2d
 
-#endif  // MIMIC2D_RENDER_SUBPROCESS_H_
+#endif  // MIMIC2D_MEDIA_SUBPROCESS_H_

@@ -1,13 +1,14 @@
-// render: what happened, shown — offscreen MuJoCo video from a reference
-// camera with 2D keypoint overlays, training plots and HTML reports.
-#ifndef MIMIC2D_RENDER_VIDEO_WRITER_H_
-#define MIMIC2D_RENDER_VIDEO_WRITER_H_
+// media: images and video in and out — RGB images, PNG, video decoding and
+// MP4 encoding through the ffmpeg binary, child processes; shared by
+// rendering and detection.
+#ifndef MIMIC2D_MEDIA_VIDEO_WRITER_H_
+#define MIMIC2D_MEDIA_VIDEO_WRITER_H_
 
 #include <memory>
 #include <string>
 
-#include "render/image.h"
-#include "render/subprocess.h"
+#include "media/image.h"
+#include "media/subprocess.h"
 
 namespace m2d {
 
@@ -57,4 +58,4 @@ class Mp4Writer {
 
 }  // namespace m2d
 
-#endif  // MIMIC2D_RENDER_VIDEO_WRITER_H_
+#endif  // MIMIC2D_MEDIA_VIDEO_WRITER_H_

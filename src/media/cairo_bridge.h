@@ -1,13 +1,14 @@
-// render: what happened, shown — offscreen MuJoCo video from a reference
-// camera with 2D keypoint overlays, training plots and HTML reports.
-#ifndef MIMIC2D_RENDER_CAIRO_BRIDGE_H_
-#define MIMIC2D_RENDER_CAIRO_BRIDGE_H_
+// media: images and video in and out — RGB images, PNG, video decoding and
+// MP4 encoding through the ffmpeg binary, child processes; shared by
+// rendering and detection.
+#ifndef MIMIC2D_MEDIA_CAIRO_BRIDGE_H_
+#define MIMIC2D_MEDIA_CAIRO_BRIDGE_H_
 
 #include <cairo.h>
 
 #include <memory>
 
-#include "render/image.h"
+#include "media/image.h"
 
 namespace m2d {
 
@@ -30,4 +31,4 @@ void ImageFromSurface(cairo_surface_t* surface, RgbImage* image);
 
 }  // namespace m2d
 
-#endif  // MIMIC2D_RENDER_CAIRO_BRIDGE_H_
+#endif  // MIMIC2D_MEDIA_CAIRO_BRIDGE_H_

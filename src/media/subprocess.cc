@@ -1,4 +1,4 @@
-#include "render/subprocess.h"
+#include "media/subprocess.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -52,7 +52,8 @@ bool WriteWithoutSigpipe(int fd, const char* bytes, size_t size) {
 
 }  // namespace
 
-PipedProcess::PipedProcess(const std::vector<std::string>& argv) {
+PipedProcess::PipedProcess(const std::vector<std::string>& argv,
+                           PipeDirection direction) {
   if (argv.empty()) throw std::invalid_argument("PipedProcess: empty argv");
   char output_template[] = "/tmp/mimic2d_process_XXXXXX";
   const int output_fd = mkostemp(output_template, O_CLOEXEC);
@@ -67,11 +68,18 @@ PipedProcess::PipedProcess(const std::vector<std::string>& argv) {
     std::filesystem::remove(output_path_);
     throw std::runtime_error("cannot create a pipe for " + argv[0]);
   }
+  const bool to_child = direction == PipeDirection::kToChild;
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   // dup2 clears close-on-exec on the child's 0, 1 and 2 only.
-  posix_spawn_file_actions_adddup2(&actions, pipe_fds[0], STDIN_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, output_fd, STDOUT_FILENO);
+  if (to_child) {
+    posix_spawn_file_actions_adddup2(&actions, pipe_fds[0], STDIN_FILENO);
+    posix_spawn_file_actions_adddup2(&actions, output_fd, STDOUT_FILENO);
+  } else {
+    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null",
+                                     O_RDONLY, 0);
+    posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+  }
   posix_spawn_file_actions_adddup2(&actions, output_fd, STDERR_FILENO);
   std::vector<char*> args;
   for (const std::string& arg : argv)
@@ -80,20 +88,23 @@ PipedProcess::PipedProcess(const std::vector<std::string>& argv) {
   const int error = posix_spawnp(&pid_, argv[0].c_str(), &actions, nullptr,
                                  args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  ::close(pipe_fds[0]);
+  // Keep our end only.
+  const int ours = to_child ? pipe_fds[1] : pipe_fds[0];
+  ::close(to_child ? pipe_fds[0] : pipe_fds[1]);
   ::close(output_fd);
   if (error != 0) {
-    ::close(pipe_fds[1]);
+    ::close(ours);
     std::filesystem::remove(output_path_);
     pid_ = -1;
     throw std::runtime_error("cannot run '" + argv[0] +
                              "': " + ErrnoText(error));
   }
-  stdin_fd_ = pipe_fds[1];
+  (to_child ? stdin_fd_ : stdout_fd_) = ours;
 }
 
 PipedProcess::~PipedProcess() {
   if (stdin_fd_ >= 0) ::close(stdin_fd_);
+  if (stdout_fd_ >= 0) ::close(stdout_fd_);
   if (pid_ > 0) {
     ::kill(pid_, SIGTERM);
     int status = 0;
@@ -111,11 +122,30 @@ bool PipedProcess::Write(const void* bytes, size_t size) {
   return WriteWithoutSigpipe(stdin_fd_, static_cast<const char*>(bytes), size);
 }
 
+size_t PipedProcess::Read(void* bytes, size_t size) {
+  if (stdout_fd_ < 0) return 0;
+  char* out = static_cast<char*>(bytes);
+  size_t total = 0;
+  while (total < size) {
+    const ssize_t got = ::read(stdout_fd_, out + total, size - total);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    total += static_cast<size_t>(got);
+  }
+  return total;
+}
+
 ProcessResult PipedProcess::Wait() {
   if (pid_ <= 0) throw std::logic_error("PipedProcess::Wait called twice");
   if (stdin_fd_ >= 0) {
     ::close(stdin_fd_);
     stdin_fd_ = -1;
+  }
+  // A reader that stops early closes its end: the child gets SIGPIPE or
+  // EPIPE and exits.
+  if (stdout_fd_ >= 0) {
+    ::close(stdout_fd_);
+    stdout_fd_ = -1;
   }
   int status = 0;
   while (::waitpid(pid_, &status, 0) < 0) {

@@ -1,11 +1,11 @@
-#include "render/image.h"
+#include "media/image.h"
 
 #include <cstring>
 #include <stdexcept>
 
 #include "common/error.h"
 #include "common/file_io.h"
-#include "render/cairo_bridge.h"
+#include "media/cairo_bridge.h"
 
 namespace m2d {
 namespace {
