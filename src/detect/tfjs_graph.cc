@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <unordered_map>
 
@@ -158,33 +159,82 @@ torch::Tensor GatherNd(const torch::Tensor& params,
   return gathered.reshape(out_shape);
 }
 
+// TensorFlow's StridedSlice for positive strides, without ellipsis: per
+// entry of `begin`, a new axis, a single index (shrink) or a range.
+torch::Tensor StridedSlice(const torch::Tensor& x, const torch::Tensor& begin,
+                           const torch::Tensor& end,
+                           const torch::Tensor& strides, int64_t begin_mask,
+                           int64_t end_mask, int64_t new_axis_mask,
+                           int64_t shrink_axis_mask, const std::string& where) {
+  torch::Tensor b = begin.to(torch::kLong).contiguous();
+  torch::Tensor e = end.to(torch::kLong).contiguous();
+  torch::Tensor s = strides.to(torch::kLong).contiguous();
+  torch::Tensor y = x;
+  int64_t dim = 0;  // the next dimension of y to slice
+  for (int64_t i = 0; i < b.numel(); ++i) {
+    const int64_t bit = int64_t{1} << i;
+    if (new_axis_mask & bit) {
+      y = y.unsqueeze(dim++);
+      continue;
+    }
+    if (dim >= y.dim())
+      throw InputError(where, "StridedSlice indexes past the tensor's rank");
+    const int64_t size = y.size(dim);
+    const int64_t stride = s.data_ptr<int64_t>()[i];
+    if (stride <= 0)
+      throw InputError(where, "StridedSlice with a non-positive stride");
+    auto clamp = [&](int64_t v) {
+      if (v < 0) v += size;
+      return std::clamp<int64_t>(v, 0, size);
+    };
+    if (shrink_axis_mask & bit) {
+      int64_t index = b.data_ptr<int64_t>()[i];
+      if (index < 0) index += size;
+      y = y.select(dim, index);
+      continue;
+    }
+    const int64_t start =
+        (begin_mask & bit) ? 0 : clamp(b.data_ptr<int64_t>()[i]);
+    const int64_t stop =
+        (end_mask & bit) ? size : clamp(e.data_ptr<int64_t>()[i]);
+    y = y.slice(dim, start, std::max(start, stop), stride);
+    ++dim;
+  }
+  return y;
+}
+
+// The axes of a reduction (a scalar or a vector tensor), normalized.
+std::vector<int64_t> ReductionAxes(const torch::Tensor& axes, int64_t rank) {
+  torch::Tensor a = axes.to(torch::kLong).contiguous().reshape({-1});
+  std::vector<int64_t> dims;
+  for (int64_t i = 0; i < a.numel(); ++i)
+    dims.push_back(NormalizeAxis(a.data_ptr<int64_t>()[i], rank));
+  return dims;
+}
+
+std::vector<int64_t> ToSizes(const torch::Tensor& t) {
+  torch::Tensor a = t.to(torch::kLong).contiguous().reshape({-1});
+  return std::vector<int64_t>(a.data_ptr<int64_t>(),
+                              a.data_ptr<int64_t>() + a.numel());
+}
+
 }  // namespace
 
 const std::vector<std::string>& TfjsGraphModel::SupportedOps() {
-  static const std::vector<std::string> ops = {"Const",
-                                               "Placeholder",
-                                               "Identity",
-                                               "Cast",
-                                               "Unpack",
-                                               "ExpandDims",
-                                               "Squeeze",
-                                               "Reshape",
-                                               "Sub",
-                                               "Mul",
-                                               "AddV2",
-                                               "RealDiv",
-                                               "FloorDiv",
-                                               "SquaredDifference",
-                                               "Sqrt",
-                                               "Sigmoid",
-                                               "_FusedConv2D",
-                                               "FusedDepthwiseConv2dNative",
-                                               "DepthwiseConv2dNative",
-                                               "ResizeBilinear",
-                                               "ArgMax",
-                                               "Pack",
-                                               "ConcatV2",
-                                               "GatherNd"};
+  // clang-format off
+  static const std::vector<std::string> ops = {
+      // MoveNet single pose.
+      "Const", "Placeholder", "Identity", "Cast", "Unpack", "ExpandDims",
+      "Squeeze", "Reshape", "Sub", "Mul", "AddV2", "RealDiv", "FloorDiv",
+      "SquaredDifference", "Sqrt", "Sigmoid", "_FusedConv2D",
+      "FusedDepthwiseConv2dNative", "DepthwiseConv2dNative", "ResizeBilinear",
+      "ArgMax", "Pack", "ConcatV2", "GatherNd",
+      // MoveNet MultiPose adds these.
+      "Shape", "Size", "StridedSlice", "MaxPool", "Abs", "Exp", "Reciprocal",
+      "Minimum", "Maximum", "Less", "Greater", "GreaterEqual", "Equal",
+      "LogicalAnd", "Range", "Tile", "Fill", "TopKV2", "AddN", "Split", "Max",
+      "Sum", "Select"};
+  // clang-format on
   return ops;
 }
 
@@ -296,6 +346,15 @@ TfjsGraphModel TfjsGraphModel::Load(const std::string& model_json_path) {
     node.strides = IntList(attr, "strides");
     node.dilations = IntList(attr, "dilations");
     node.squeeze_dims = IntList(attr, "squeeze_dims");
+    node.ksize = IntList(attr, "ksize");
+    node.keep_dims = BoolAttr(attr, "keep_dims");
+    node.begin_mask = IntAttr(attr, "begin_mask");
+    node.end_mask = IntAttr(attr, "end_mask");
+    node.new_axis_mask = IntAttr(attr, "new_axis_mask");
+    node.shrink_axis_mask = IntAttr(attr, "shrink_axis_mask");
+    if (IntAttr(attr, "ellipsis_mask") != 0)
+      throw InputError(file, "node " + node.name + ": ellipsis_mask");
+    if (node.op == "Split") node.num = IntAttr(attr, "num_split");
     if (attr.contains("padding"))
       node.padding = DecodeBase64(attr["padding"].value("s", ""));
     if (attr.contains("fused_ops")) {
@@ -314,7 +373,7 @@ TfjsGraphModel TfjsGraphModel::Load(const std::string& model_json_path) {
       throw InputError(file, "node " + node.name + ": padding " + node.padding);
     }
     node.axis = IntAttr(attr, "axis");
-    node.num = IntAttr(attr, "num");
+    if (node.op == "Unpack") node.num = IntAttr(attr, "num");
     if (node.op == "Cast")
       node.cast_to = DtypeOf(attr["DstT"]["type"].get<std::string>(), file);
     node.align_corners = BoolAttr(attr, "align_corners");
@@ -538,6 +597,106 @@ std::vector<torch::Tensor> TfjsGraphModel::Execute(
   if (op == "GatherNd") {
     arity(2);
     return {GatherNd(in[0], in[1])};
+  }
+  // MoveNet MultiPose's ops.
+  if (op == "Shape") {
+    std::vector<int32_t> sizes(in.at(0).sizes().begin(), in[0].sizes().end());
+    return {torch::tensor(sizes, torch::kInt)};
+  }
+  if (op == "Size")
+    return {torch::tensor(static_cast<int32_t>(in.at(0).numel()), torch::kInt)};
+  if (op == "StridedSlice") {
+    arity(4);
+    return {StridedSlice(in[0], in[1], in[2], in[3], node.begin_mask,
+                         node.end_mask, node.new_axis_mask,
+                         node.shrink_axis_mask, path_ + " node " + node.name)};
+  }
+  if (op == "MaxPool") {
+    torch::Tensor nchw = in.at(0).permute({0, 3, 1, 2});
+    const int64_t kh = node.ksize.at(1), kw = node.ksize.at(2);
+    const int64_t sh = node.strides.at(1), sw = node.strides.at(2);
+    if (node.padding == "SAME") {
+      const auto [top, bottom] = SamePadding(nchw.size(2), kh, sh, 1);
+      const auto [left, right] = SamePadding(nchw.size(3), kw, sw, 1);
+      nchw = F::pad(nchw, F::PadFuncOptions({left, right, top, bottom})
+                              .value(-std::numeric_limits<float>::infinity()));
+    }
+    return {torch::max_pool2d(nchw, {kh, kw}, {sh, sw}).permute({0, 2, 3, 1})};
+  }
+  if (op == "Abs") return {torch::abs(in.at(0))};
+  if (op == "Exp") return {torch::exp(in.at(0))};
+  if (op == "Reciprocal") return {torch::reciprocal(in.at(0))};
+  if (op == "Minimum") {
+    arity(2);
+    return {torch::minimum(in[0], in[1])};
+  }
+  if (op == "Maximum") {
+    arity(2);
+    return {torch::maximum(in[0], in[1])};
+  }
+  if (op == "Less") {
+    arity(2);
+    return {torch::lt(in[0], in[1])};
+  }
+  if (op == "Greater") {
+    arity(2);
+    return {torch::gt(in[0], in[1])};
+  }
+  if (op == "GreaterEqual") {
+    arity(2);
+    return {torch::ge(in[0], in[1])};
+  }
+  if (op == "Equal") {
+    arity(2);
+    return {torch::eq(in[0], in[1])};
+  }
+  if (op == "LogicalAnd") {
+    arity(2);
+    return {torch::logical_and(in[0], in[1])};
+  }
+  if (op == "Range") {
+    arity(3);
+    const torch::ScalarType dtype = in[0].scalar_type();
+    return {torch::arange(in[0].item<double>(), in[1].item<double>(),
+                          in[2].item<double>(), torch::TensorOptions(dtype))};
+  }
+  if (op == "Tile") {
+    arity(2);
+    return {in[0].repeat(ToSizes(in[1]))};
+  }
+  if (op == "Fill") {
+    arity(2);
+    return {torch::full(ToSizes(in[0]), in[1].item(),
+                        torch::TensorOptions(in[1].scalar_type()))};
+  }
+  if (op == "TopKV2") {
+    arity(2);
+    auto [values, indices] =
+        torch::topk(in[0], in[1].item<int64_t>(), -1, true, true);
+    return {values, indices.to(torch::kInt)};
+  }
+  if (op == "AddN") {
+    torch::Tensor sum = in.at(0);
+    for (size_t i = 1; i < in.size(); ++i) sum = sum + in[i];
+    return {sum};
+  }
+  if (op == "Split") {
+    arity(2);  // split_dim, value
+    const int64_t axis = NormalizeAxis(in[0].item<int64_t>(), in[1].dim());
+    return torch::chunk(in[1], node.num, axis);
+  }
+  if (op == "Max" || op == "Sum") {
+    arity(2);
+    const std::vector<int64_t> axes = ReductionAxes(in[1], in[0].dim());
+    if (op == "Sum") return {torch::sum(in[0], axes, node.keep_dims)};
+    return {torch::amax(in[0], axes, node.keep_dims)};
+  }
+  if (op == "Select") {
+    arity(3);
+    torch::Tensor condition = in[0];
+    // TF's Select: a vector condition picks whole rows of higher-rank values.
+    while (condition.dim() < in[1].dim()) condition = condition.unsqueeze(-1);
+    return {torch::where(condition, in[1], in[2])};
   }
   throw InputError(path_, "node " + node.name + ": op '" + op +
                               "' is not supported by this interpreter");

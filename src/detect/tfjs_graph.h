@@ -15,9 +15,9 @@ namespace m2d {
 // A TF.js graph model (model.json + its weight shards, as tfjs-converter
 // writes them) run on LibTorch tensors. Tensors keep TensorFlow's layout
 // (NHWC) and semantics; convolutions run on channels-last views of them, so
-// no layout copies are made. Supports the ops MoveNet's single-pose models
-// use (SupportedOps()); loading a graph with any other op is an InputError
-// naming the file and the op.
+// no layout copies are made. Supports the ops MoveNet's single- and
+// multi-pose models use (SupportedOps()); loading a graph with any other op
+// is an InputError naming the file and the op.
 class TfjsGraphModel {
  public:
   // Reads `model_json_path` and the weight files its manifest names (next
@@ -43,11 +43,15 @@ class TfjsGraphModel {
     // Inputs as (node index, output index); control inputs dropped.
     std::vector<std::pair<int, int>> inputs;
     // Attributes this interpreter reads, decoded at load.
-    std::vector<int64_t> strides, dilations, squeeze_dims;
+    std::vector<int64_t> strides, dilations, squeeze_dims, ksize;
     std::string padding;                 // SAME / VALID
     std::vector<std::string> fused_ops;  // BiasAdd, Relu, Relu6
     int64_t axis = 0;                    // Unpack, Pack
-    int64_t num = 0;                     // Unpack outputs
+    int64_t num = 0;                     // Unpack outputs, Split parts
+    bool keep_dims = false;              // Max, Sum
+    // StridedSlice's bit masks (ellipsis_mask must be 0).
+    int64_t begin_mask = 0, end_mask = 0, new_axis_mask = 0,
+            shrink_axis_mask = 0;
     torch::ScalarType cast_to = torch::kFloat;
     bool align_corners = false, half_pixel_centers = false;
   };
