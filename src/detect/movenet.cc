@@ -56,6 +56,8 @@ Box KeypointBox(const DetectedPerson& person, double min_score) {
   return count >= 2 ? box : Box();
 }
 
+void SetDetectionThreads(int threads) { torch::set_num_threads(threads); }
+
 std::string DefaultMoveNetFolder() {
   const char* override_folder = std::getenv("MIMIC2D_MODELS");
   if (override_folder != nullptr && *override_folder != '\0')

@@ -44,6 +44,10 @@ struct DetectedPerson {
 // when fewer than 2 do).
 Box KeypointBox(const DetectedPerson& person, double min_score);
 
+// LibTorch's intra-op threads for detection (one is best when another
+// process competes for the cores: two then collapse; docs/video.md).
+void SetDetectionThreads(int threads);
+
 // The folder with the MoveNet files: $MIMIC2D_MODELS when set, else
 // assets/models/movenet of the source tree (setup.sh fills it).
 std::string DefaultMoveNetFolder();

@@ -4,10 +4,12 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "common/file_io.h"
 #include "motion/bundle.h"
+#include "motion/clip_io.h"
 #include "motion/motion_io.h"
 #include "synthetic_motion.h"
 #include "test_paths.h"
@@ -327,6 +329,68 @@ TEST(Cli, UnknownOrMissingCommandsListTheCommands) {
   EXPECT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("`asi.anchor_share`"), std::string::npos)
       << result.output;
+}
+
+// `mimic2d keypoints` on a real recording (Debian opencv-doc's vtest.avi,
+// pedestrians about 70 px tall): a clip of the frames read, at the video's
+// rate and size, with a person in nearly every frame, and an overlay video.
+TEST(Cli, KeypointsFollowAPersonInARealVideo) {
+  const std::string dir = testing::TempDir("cli_keypoints");
+  const std::string clip_path = dir + "/vtest.json";
+  CommandResult result = RunMimic2d(
+      "keypoints /usr/share/doc/opencv-doc/examples/data/vtest.avi "
+      "--max-frames 40 --quiet -o " +
+      clip_path + " --overlay " + dir + "/overlay.mp4");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  Clip2D clip = ReadClip(clip_path);
+  EXPECT_EQ(clip.num_frames(), 40);
+  EXPECT_DOUBLE_EQ(clip.fps, 10.0);
+  EXPECT_EQ(clip.image_width_px, 768);
+  EXPECT_EQ(clip.image_height_px, 576);
+  int with_person = 0;
+  for (int t = 0; t < clip.num_frames(); ++t) {
+    int confident = 0;
+    for (int j = 0; j < 17; ++j)
+      confident += clip.keypoints.at(t, j).confidence > 0.3 ? 1 : 0;
+    with_person += confident >= 8 ? 1 : 0;
+  }
+  EXPECT_GE(with_person, 36) << result.output;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/overlay.mp4"));
+}
+
+TEST(Cli, KeypointsNameBadVideosAndMissingModels) {
+  const std::string dir = testing::TempDir("cli_keypoints_bad");
+  const std::string text = WriteFile(dir, "notes.mp4", "not a video\n");
+  CommandResult result =
+      RunMimic2d("keypoints " + text + " -o " + dir + "/a.json");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find(text), std::string::npos) << result.output;
+
+  result =
+      RunMimic2d("keypoints " + dir + "/missing.mp4 -o " + dir + "/a.json");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find("missing.mp4"), std::string::npos);
+
+  result = RunMimic2d(
+      "keypoints /usr/share/doc/opencv-doc/examples/data/vtest.avi --models " +
+      dir + " -o " + dir + "/a.json");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find(dir + "/movenet-lightning.json"),
+            std::string::npos)
+      << result.output;
+
+  // A grey video of 10 frames: nobody in it.
+  const std::string grey = dir + "/grey.mp4";
+  ASSERT_EQ(std::system(("ffmpeg -loglevel error -y -f lavfi -i "
+                         "color=c=gray:s=320x240:r=10:d=1 " +
+                         grey)
+                            .c_str()),
+            0);
+  result = RunMimic2d("keypoints " + grey + " --quiet -o " + dir + "/a.json");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.output.find("no person found"), std::string::npos)
+      << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/a.json"));
 }
 
 }  // namespace

@@ -31,7 +31,9 @@ TEST(VideoReader, DecodesEveryFrameOfARealVideo) {
   }
   EXPECT_EQ(frames, 795);
   EXPECT_EQ(reader.frames_read(), 795);
-  if (reader.info().num_frames > 0) EXPECT_EQ(frames, reader.info().num_frames);
+  if (reader.info().num_frames > 0) {
+    EXPECT_EQ(frames, reader.info().num_frames);
+  }
   EXPECT_GT(brightness, 0);  // not a black frame
   EXPECT_FALSE(reader.Read(&frame));
 }
