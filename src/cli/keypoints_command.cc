@@ -27,7 +27,8 @@ struct KeypointsArgs {
   MoveNetModel model = MoveNetModel::kLightning;
   std::string person = "track";  // track | largest | N
   int64_t max_frames = 0;        // 0: all
-  int threads = 1;  // two collapse when another process wants a core
+  int threads = 1;        // two collapse when another process wants a core
+  bool keep_all = false;  // keep the frames before and after the person
   bool quiet = false;
 };
 
@@ -76,6 +77,7 @@ int RunKeypoints(const KeypointsArgs& args) {
   clip.image_width_px = info.width_px;
   clip.image_height_px = info.height_px;
   std::vector<std::array<Keypoint2D, 17>> frames;
+  std::vector<bool> has_person;
   RgbImage frame;
   int64_t found = 0, reacquired = 0;
   const int64_t total = args.max_frames > 0
@@ -94,6 +96,7 @@ int RunKeypoints(const KeypointsArgs& args) {
       reacquired += tracked.reacquired ? 1 : 0;
     }
     frames.push_back(keypoints);
+    has_person.push_back(tracked.found);
     if (overlay) {
       RgbImage shown = frame;
       if (shown.width_px() != (info.width_px & ~1) ||
@@ -144,19 +147,29 @@ int RunKeypoints(const KeypointsArgs& args) {
     throw InputError(args.video, "no person found in any of its " +
                                      std::to_string(frames.size()) + " frames");
   }
-  clip.keypoints = KeypointTrack(static_cast<int>(frames.size()), 17);
-  for (size_t t = 0; t < frames.size(); ++t)
-    for (int j = 0; j < 17; ++j)
-      clip.keypoints.at(static_cast<int>(t), j) = frames[t][j];
+  // The person's span: from the first frame that found them to the last.
+  size_t first = 0, last = frames.size() - 1;
+  if (!args.keep_all) {
+    while (!has_person[first]) ++first;
+    while (!has_person[last]) --last;
+  }
+  const int kept = static_cast<int>(last - first + 1);
+  clip.keypoints = KeypointTrack(kept, 17);
+  for (int t = 0; t < kept; ++t)
+    for (int j = 0; j < 17; ++j) clip.keypoints.at(t, j) = frames[first + t][j];
   WriteClip(args.output, clip);
   if (overlay) overlay->Finish();
   std::printf(
-      "%zu frames in %.1f s (%.1f frames/s): person found in %lld (%.1f%%), "
-      "found again by MultiPose %lld times (%d MultiPose runs)\nwrote %s\n",
+      "%zu frames in %.1f s (%.1f frames/s): the person in %lld (%.1f%%) of "
+      "video frames %zu-%zu (%.1f%% of the video)%s, found again by "
+      "MultiPose %lld times (%d MultiPose runs)\nwrote %s: %d frames, "
+      "video frames %zu-%zu\n",
       frames.size(), seconds, frames.size() / seconds,
-      static_cast<long long>(found), 100.0 * found / frames.size(),
+      static_cast<long long>(found), 100.0 * found / (last - first + 1), first,
+      last, 100.0 * found / frames.size(),
+      tracker.ended() ? "; lost for good after that" : "",
       static_cast<long long>(reacquired), tracker.multipose_runs(),
-      args.output.c_str());
+      args.output.c_str(), kept, first, last);
   if (overlay) std::printf("wrote %s\n", args.overlay.c_str());
   return 0;
 }
@@ -197,6 +210,9 @@ void AddKeypointsCommand(CLI::App& app, CommandRun* run) {
   command->add_option("--threads", args->threads, "LibTorch threads")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  command->add_flag("--keep-all", args->keep_all,
+                    "Keep every frame (default: from the first frame with the "
+                    "person to the last)");
   command->add_flag("--quiet", args->quiet, "No progress line");
   command->callback(
       [run, args] { *run = [args] { return RunKeypoints(*args); }; });

@@ -93,6 +93,7 @@ TrackedFrame PersonTracker::Next(const RgbImage& frame) {
   // holds; otherwise run MultiPose, choose the person (first sighting or
   // re-acquisition) and refine them with single pose.
   TrackedFrame result;
+  if (ended_) return result;
   if (following_ && options_.choice != PersonChoice::kLargest) {
     DetectedPerson followed = Refine(frame, *last_box_);
     if (followed.score >= options_.min_track_score &&
@@ -107,7 +108,16 @@ TrackedFrame PersonTracker::Next(const RgbImage& frame) {
   ++multipose_runs_;
   std::optional<DetectedPerson> chosen = Choose(movenet_.DetectPeople(
       frame, options_.multipose_long_side_px, options_.min_person_score));
-  if (!chosen) return result;
+  if (!chosen) {
+    // Gone for too long: whoever appears there later is someone else.
+    if (last_box_ && options_.choice != PersonChoice::kLargest &&
+        options_.max_lost_frames > 0 &&
+        ++lost_frames_ > options_.max_lost_frames) {
+      ended_ = true;
+    }
+    return result;
+  }
+  lost_frames_ = 0;
   DetectedPerson refined = Refine(frame, chosen->box);
   result.found = true;
   result.reacquired = true;

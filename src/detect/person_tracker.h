@@ -33,7 +33,11 @@ struct PersonTrackerOptions {
   // the last one by this IoU, or its centre is within this many of the
   // last box's diagonals.
   double reacquire_min_iou = 0.1;
-  double reacquire_max_centre_diagonals = 1.5;
+  double reacquire_max_centre_diagonals = 1.0;
+  // kTrack and kIndex: a person lost for more than this many frames is
+  // gone (left the scene): the track ends rather than continue with
+  // whoever passes where they were. 0: never ends.
+  int max_lost_frames = 10;
   void Validate() const;  // throws ConfigError
 };
 
@@ -52,6 +56,8 @@ class PersonTracker {
   TrackedFrame Next(const RgbImage& frame);
 
   int multipose_runs() const { return multipose_runs_; }
+  // The followed person was lost for longer than max_lost_frames.
+  bool ended() const { return ended_; }
 
  private:
   // The detection that continues the track (or starts it), if any.
@@ -64,6 +70,8 @@ class PersonTracker {
   PersonTrackerOptions options_;
   std::optional<Box> last_box_;  // where the person was last seen
   bool following_ = false;       // the last frame found them
+  int lost_frames_ = 0;          // frames since they were last found
+  bool ended_ = false;
   int multipose_runs_ = 0;
 };
 
