@@ -54,7 +54,7 @@ int RunFit(FitArgs& args) {
     };
   }
   args.options.Validate();
-  const ReferenceBundle bundle = ReadBundle(args.input);
+  const ReferenceBundle bundle = ReadBundleOrClip(args.input);
   const std::string character_path = args.character.find('/') == 0
                                          ? args.character
                                          : AssetPath(args.character);
@@ -100,7 +100,9 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
       "fit",
       "Estimate each view's camera and the character's 3D poses from its 2D "
       "keypoints alone (Ceres), into the bundle's estimate section");
-  fit->add_option("input", args->input, "reference bundle (2D; truth unused)");
+  fit->add_option("input", args->input,
+                  "reference bundle (2D; truth unused) or a 2D clip (one "
+                  "view, e.g. from `mimic2d keypoints`)");
   fit->add_option("-o,--output", args->output, "bundle with the estimate");
   fit->add_flag("--list-settings", args->list_settings,
                 "Print every --config setting with its default, allowed "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 
 #include "camera/camera_io.h"
@@ -291,6 +292,21 @@ void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
                        "ground-truth poses do not match the frame count");
     }
   }
+}
+
+ReferenceBundle ReadBundleOrClip(const std::string& path) {
+  const nlohmann::json json = ReadJsonFile(path);
+  if (!json.is_object() || json.value("format", "") != kClipFormat)
+    return ReadBundle(path);
+  ReferenceBundle bundle;
+  bundle.name = std::filesystem::path(path).stem().string();
+  ReferenceView view;
+  view.name = "view0";
+  view.clip = ReadClip(path);
+  bundle.fps = view.clip.fps;
+  bundle.views.push_back(std::move(view));
+  ValidateBundle(bundle, path);
+  return bundle;
 }
 
 ReferenceBundle ReadBundle(const std::string& path) {

@@ -100,6 +100,10 @@ inline constexpr int kBundleVersion = 2;
 void ValidateBundle(const ReferenceBundle& bundle, const std::string& source);
 // Reads versions 1 and 2; writes version 2 (atomically).
 ReferenceBundle ReadBundle(const std::string& path);
+// A bundle file, or a 2D clip file (mimic2d.clip, e.g. `mimic2d keypoints`
+// output) read as a one-view bundle named after the file: what a user with
+// one video has.
+ReferenceBundle ReadBundleOrClip(const std::string& path);
 void WriteBundle(const std::string& path, const ReferenceBundle& bundle);
 
 // What a user with videos has: the 2D clips (image size, fps, names), with

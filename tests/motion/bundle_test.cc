@@ -6,6 +6,7 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
+#include "motion/clip_io.h"
 #include "motion/motion_io.h"
 #include "synthetic_motion.h"
 #include "test_paths.h"
@@ -117,6 +118,28 @@ TEST(Bundle, AimingAtThePathsMiddleCentresATravellingSubject) {
                .CameraAt(0)
                .CenterWorld();
   EXPECT_NEAR(centre.x(), start.x(), 1e-9);
+}
+
+// A user with one video has a clip, not a bundle: `fit` reads it as a
+// one-view bundle named after the file; a bundle file reads as before.
+TEST(Bundle, AClipFileReadsAsAOneViewBundle) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  WalkFixture walk = LoadWalk(path);
+  BundleFromMotionOptions options;
+  options.rig.num_views = 2;
+  ReferenceBundle bundle =
+      MakeBundleFromMotion(walk.motion, walk.map, options, "walk");
+  const std::string dir = testing::TempDir("bundle_or_clip");
+  WriteClip(dir + "/my_video.json", bundle.views[1].clip);
+  WriteBundle(dir + "/walk_bundle.json", bundle);
+  ReferenceBundle from_clip = ReadBundleOrClip(dir + "/my_video.json");
+  EXPECT_EQ(from_clip.name, "my_video");
+  ASSERT_EQ(from_clip.views.size(), 1u);
+  EXPECT_TRUE(from_clip.views[0].cameras.empty());
+  EXPECT_FALSE(from_clip.ground_truth.has_value());
+  EXPECT_DOUBLE_EQ(from_clip.fps, bundle.fps);
+  EXPECT_EQ(from_clip.num_frames(), bundle.num_frames());
+  EXPECT_EQ(ReadBundleOrClip(dir + "/walk_bundle.json").views.size(), 2u);
 }
 
 TEST(Bundle, DetectorNoiseIsSeededAndHasTheRequestedStatistics) {
