@@ -75,6 +75,22 @@ int RunStrip(const StripArgs& args) {
   return 0;
 }
 
+struct ResampleArgs {
+  std::string input;
+  std::string output;
+  double fps = 30.0;
+};
+
+int RunResample(const ResampleArgs& args) {
+  const Clip2D clip = ReadClip(args.input);
+  const Clip2D resampled = ResampleClip(clip, args.fps);
+  WriteClip(args.output, resampled);
+  std::cout << "wrote " << args.output << ": " << resampled.num_frames()
+            << " frames at " << resampled.fps << " fps (from "
+            << clip.num_frames() << " at " << clip.fps << " fps)\n";
+  return 0;
+}
+
 int RunInfo(const std::string& path) {
   nlohmann::json json = ReadJsonFile(path);
   if (json.is_object() && json.value("format", "") == kBundleFormat) {
@@ -153,6 +169,20 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
       ->required();
   strip_cmd->callback(
       [run, strip] { *run = [strip] { return RunStrip(*strip); }; });
+
+  auto resample = std::make_shared<ResampleArgs>();
+  CLI::App* resample_cmd = clip->add_subcommand(
+      "resample",
+      "A clip at another frame rate (keypoints interpolated), e.g. a 10 fps "
+      "video's clip at the 30 Hz control rate");
+  resample_cmd->add_option("clip", resample->input, "Clip JSON")->required();
+  resample_cmd->add_option("-o,--output", resample->output, "Clip to write")
+      ->required();
+  resample_cmd->add_option("--fps", resample->fps, "Frame rate (Hz)")
+      ->capture_default_str();
+  resample_cmd->callback([run, resample] {
+    *run = [resample] { return RunResample(*resample); };
+  });
 
   auto info_path = std::make_shared<std::string>();
   CLI::App* info = clip->add_subcommand("info", "Summarize a clip or a bundle");

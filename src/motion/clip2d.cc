@@ -1,5 +1,6 @@
 #include "motion/clip2d.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/error.h"
@@ -64,6 +65,54 @@ void ValidateClip(const Clip2D& clip, const std::string& source) {
                     "object '" + object.name + "' frame " + std::to_string(t));
     }
   }
+}
+
+namespace {
+
+Keypoint2D BlendKeypoints(const Keypoint2D& a, const Keypoint2D& b,
+                          double alpha) {
+  if (a.IsPresent() && b.IsPresent()) {
+    return {a.x_px + alpha * (b.x_px - a.x_px),
+            a.y_px + alpha * (b.y_px - a.y_px),
+            std::min(a.confidence, b.confidence)};
+  }
+  const Keypoint2D& nearer = alpha < 0.5 ? a : b;
+  if (nearer.IsPresent()) return nearer;
+  return Keypoint2D{std::nan(""), std::nan(""), 0.0};
+}
+
+}  // namespace
+
+Clip2D ResampleClip(const Clip2D& clip, double fps) {
+  if (!(fps >= kMinClipFps && fps <= kMaxClipFps)) {
+    throw ConfigError("resample: fps must be in [" +
+                      std::to_string(kMinClipFps) + ", " +
+                      std::to_string(kMaxClipFps) + "]");
+  }
+  Clip2D out = clip;
+  out.fps = fps;
+  const int source_frames = clip.num_frames();
+  const double span_s = (source_frames - 1) / clip.fps;
+  const int frames = static_cast<int>(std::floor(span_s * fps + 1e-9)) + 1;
+  const int num_keypoints = clip.keypoints.num_keypoints();
+  out.keypoints = KeypointTrack(frames, num_keypoints);
+  for (ObjectTrack2D& object : out.objects) object.points.assign(frames, {});
+  for (int t = 0; t < frames; ++t) {
+    const double source = t / fps * clip.fps;
+    const int before =
+        std::min(static_cast<int>(std::floor(source)), source_frames - 1);
+    const int after = std::min(before + 1, source_frames - 1);
+    const double alpha = source - before;
+    for (int j = 0; j < num_keypoints; ++j) {
+      out.keypoints.at(t, j) = BlendKeypoints(
+          clip.keypoints.at(before, j), clip.keypoints.at(after, j), alpha);
+    }
+    for (size_t o = 0; o < clip.objects.size(); ++o) {
+      out.objects[o].points[t] = BlendKeypoints(
+          clip.objects[o].points[before], clip.objects[o].points[after], alpha);
+    }
+  }
+  return out;
 }
 
 }  // namespace m2d

@@ -81,6 +81,13 @@ inline constexpr long kMaxImageSidePx = 65536;
 // one frame). Throws InputError with `source` (a file name) on failure.
 void ValidateClip(const Clip2D& clip, const std::string& source);
 
+// The clip at another frame rate (e.g. a 10 fps video to the 30 Hz control
+// rate), frame t at time t / fps over the same span: each keypoint (and
+// object point) interpolated linearly between the two source frames around
+// it when both have it (confidence: the lesser), the nearer one's
+// otherwise; missing when neither does.
+Clip2D ResampleClip(const Clip2D& clip, double fps);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_MOTION_CLIP2D_H_

@@ -615,5 +615,32 @@ TEST(ReadClipAuto, DispatchesOnWhatThePathIs) {
       << message;
 }
 
+// A 10 fps clip at 30 fps: the same span, originals on every third frame,
+// straight lines between them, a keypoint missing on one side taken from
+// the nearer side only.
+TEST(ResampleClip, InterpolatesOverTheSameSpan) {
+  Clip2D clip;
+  clip.fps = 10.0;
+  clip.keypoints = KeypointTrack(3, 17);
+  for (int t = 0; t < 3; ++t)
+    for (int j = 0; j < 17; ++j)
+      clip.keypoints.at(t, j) = {10.0 * t + j, 5.0 * t, 0.9 - 0.1 * t};
+  clip.keypoints.at(1, 4) = Keypoint2D{std::nan(""), std::nan(""), 0.0};
+  Clip2D fast = ResampleClip(clip, 30.0);
+  EXPECT_DOUBLE_EQ(fast.fps, 30.0);
+  ASSERT_EQ(fast.num_frames(), 7);  // 0.2 s at 30 Hz, both ends
+  EXPECT_DOUBLE_EQ(fast.keypoints.at(3, 0).x_px, 10.0);
+  EXPECT_NEAR(fast.keypoints.at(1, 0).x_px, 10.0 / 3, 1e-12);
+  EXPECT_NEAR(fast.keypoints.at(1, 0).y_px, 5.0 / 3, 1e-12);
+  EXPECT_NEAR(fast.keypoints.at(1, 0).confidence, 0.8, 1e-12);
+  // Keypoint 4 is missing at source frame 1 (fast frame 3).
+  EXPECT_DOUBLE_EQ(fast.keypoints.at(1, 4).x_px, 4.0);  // nearer: frame 0
+  EXPECT_FALSE(fast.keypoints.at(2, 4).IsPresent());    // nearer: missing
+  EXPECT_FALSE(fast.keypoints.at(3, 4).IsPresent());
+  EXPECT_DOUBLE_EQ(fast.keypoints.at(6, 16).x_px, 36.0);
+  ValidateClip(fast, "resampled");
+  EXPECT_THROW(ResampleClip(clip, 0.0), ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
