@@ -4,8 +4,8 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "render/report.h"
 #include "media/subprocess.h"
+#include "render/report.h"
 #include "render/training_plot.h"
 
 namespace m2d::cli {

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "camera/pinhole.h"
+#include "media/image.h"
+#include "media/video_writer.h"
 #include "motion/bundle.h"
 #include "motion/clip2d.h"
 #include "render/gl_camera.h"
-#include "media/image.h"
 #include "render/scene_renderer.h"
-#include "media/video_writer.h"
 #include "sim/simulation.h"
 
 namespace m2d {

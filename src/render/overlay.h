@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "motion/clip2d.h"
-#include "motion/layout.h"
 #include "media/cairo_bridge.h"
 #include "media/image.h"
+#include "motion/clip2d.h"
+#include "motion/layout.h"
 
 namespace m2d {
 
