@@ -2,6 +2,7 @@
 // ordinary video (MoveNet on LibTorch), written as a 2D clip; optionally an
 // overlay video for checking by eye.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -40,15 +41,16 @@ PersonTrackerOptions TrackerOptionsFor(const std::string& person) {
     options.choice = PersonChoice::kLargest;
   } else {
     options.choice = PersonChoice::kIndex;
-    try {
-      size_t used = 0;
-      options.person_index = std::stoi(person, &used);
-      if (used != person.size() || options.person_index < 0) throw 0;
-    } catch (...) {
+    const bool digits = !person.empty() && person.size() < 6 &&
+                        std::all_of(person.begin(), person.end(), [](char c) {
+                          return c >= '0' && c <= '9';
+                        });
+    if (!digits) {
       throw ConfigError(
           "--person must be track, largest or a number >= 0, not '" + person +
           "'");
     }
+    options.person_index = std::stoi(person);
   }
   return options;
 }

@@ -96,18 +96,28 @@ DetectedPerson MoveNet::DetectInRegion(const RgbImage& image,
   const int64_t left = static_cast<int64_t>(std::floor(x0));
   const int64_t top = static_cast<int64_t>(std::floor(y0));
   const int64_t side = std::max<int64_t>(1, std::llround(side_px));
-  torch::Tensor full = ImageTensor(image);
+  // Only the part inside the image is converted to float; the rest is
+  // black padding (not the whole frame per call: this runs every frame).
   const int64_t width = image.width_px(), height = image.height_px();
-  torch::Tensor padded = F::pad(
-      full, F::PadFuncOptions({std::max<int64_t>(0, -left),
-                               std::max<int64_t>(0, left + side - width),
-                               std::max<int64_t>(0, -top),
-                               std::max<int64_t>(0, top + side - height)}));
-  torch::Tensor region =
-      padded
-          .slice(2, std::max<int64_t>(0, top), std::max<int64_t>(0, top) + side)
-          .slice(3, std::max<int64_t>(0, left),
-                 std::max<int64_t>(0, left) + side);
+  const int64_t inside_x0 = std::clamp<int64_t>(left, 0, width);
+  const int64_t inside_x1 = std::clamp<int64_t>(left + side, 0, width);
+  const int64_t inside_y0 = std::clamp<int64_t>(top, 0, height);
+  const int64_t inside_y1 = std::clamp<int64_t>(top + side, 0, height);
+  torch::Tensor region;
+  if (inside_x1 <= inside_x0 || inside_y1 <= inside_y0) {
+    region = torch::zeros({1, 3, side, side});
+  } else {
+    torch::Tensor inside =
+        torch::from_blob(const_cast<uint8_t*>(image.data()),
+                         {1, height, width, 3}, torch::kUInt8)
+            .slice(1, inside_y0, inside_y1)
+            .slice(2, inside_x0, inside_x1)
+            .permute({0, 3, 1, 2})
+            .to(torch::kFloat);
+    region = F::pad(
+        inside, F::PadFuncOptions({inside_x0 - left, left + side - inside_x1,
+                                   inside_y0 - top, top + side - inside_y1}));
+  }
   torch::Tensor input =
       ModelInput(F::interpolate(region, F::InterpolateFuncOptions()
                                             .size(std::vector<int64_t>{n, n})

@@ -302,7 +302,7 @@ ReferenceBundle ReadBundleOrClip(const std::string& path) {
   bundle.name = std::filesystem::path(path).stem().string();
   ReferenceView view;
   view.name = "view0";
-  view.clip = ReadClip(path);
+  view.clip = ClipFromJson(JsonCursor(json, path));  // parsed once
   bundle.fps = view.clip.fps;
   bundle.views.push_back(std::move(view));
   ValidateBundle(bundle, path);
