@@ -44,36 +44,37 @@ DetectedPerson PersonTracker::Refine(const RgbImage& frame,
   return movenet_.DetectInRegion(frame, centre.x(), centre.y(), side);
 }
 
-std::optional<DetectedPerson> PersonTracker::Choose(
-    const std::vector<DetectedPerson>& people) const {
+std::optional<DetectedPerson> ChoosePerson(
+    const std::vector<DetectedPerson>& people,
+    const std::optional<Box>& last_box, const PersonTrackerOptions& options) {
   if (people.empty()) return std::nullopt;
-  if (options_.choice == PersonChoice::kLargest) {
+  if (options.choice == PersonChoice::kLargest) {
     return *std::max_element(
         people.begin(), people.end(),
         [](const DetectedPerson& a, const DetectedPerson& b) {
           return a.box.area_px2() < b.box.area_px2();
         });
   }
-  if (!last_box_) {
+  if (!last_box) {
     // The first sighting: the best-scoring person, or the N-th from the left.
-    if (options_.choice == PersonChoice::kTrack) return people.front();
+    if (options.choice == PersonChoice::kTrack) return people.front();
     std::vector<DetectedPerson> by_x = people;
     std::sort(by_x.begin(), by_x.end(),
               [](const DetectedPerson& a, const DetectedPerson& b) {
                 return Centre(a.box).x() < Centre(b.box).x();
               });
-    if (options_.person_index >= static_cast<int>(by_x.size()))
+    if (options.person_index >= static_cast<int>(by_x.size()))
       return std::nullopt;
-    return by_x[options_.person_index];
+    return by_x[options.person_index];
   }
   // Again after a loss: the detection that overlaps the last box most, or
   // whose centre is nearest to it, within the limits.
   const DetectedPerson* best = nullptr;
   double best_iou = 0.0, best_distance = INFINITY;
   for (const DetectedPerson& person : people) {
-    const double iou = BoxIou(person.box, *last_box_);
+    const double iou = BoxIou(person.box, *last_box);
     const double distance =
-        (Centre(person.box) - Centre(*last_box_)).norm() / Diagonal(*last_box_);
+        (Centre(person.box) - Centre(*last_box)).norm() / Diagonal(*last_box);
     if (iou > best_iou ||
         (best_iou == 0.0 && iou == 0.0 && distance < best_distance)) {
       best = &person;
@@ -82,8 +83,8 @@ std::optional<DetectedPerson> PersonTracker::Choose(
     }
   }
   if (best == nullptr) return std::nullopt;
-  if (best_iou >= options_.reacquire_min_iou ||
-      best_distance <= options_.reacquire_max_centre_diagonals)
+  if (best_iou >= options.reacquire_min_iou ||
+      best_distance <= options.reacquire_max_centre_diagonals)
     return *best;
   return std::nullopt;
 }
@@ -106,8 +107,10 @@ TrackedFrame PersonTracker::Next(const RgbImage& frame) {
     following_ = false;  // lost: look for them again below
   }
   ++multipose_runs_;
-  std::optional<DetectedPerson> chosen = Choose(movenet_.DetectPeople(
-      frame, options_.multipose_long_side_px, options_.min_person_score));
+  std::optional<DetectedPerson> chosen =
+      ChoosePerson(movenet_.DetectPeople(frame, options_.multipose_long_side_px,
+                                         options_.min_person_score),
+                   last_box_, options_);
   if (!chosen) {
     // Gone for too long: whoever appears there later is someone else.
     if (last_box_ && options_.choice != PersonChoice::kLargest &&

@@ -41,6 +41,14 @@ struct PersonTrackerOptions {
   void Validate() const;  // throws ConfigError
 };
 
+// The detection that starts a track (no `last_box`: first sighting by
+// `options.choice`) or continues it after a loss (the one overlapping
+// `last_box` most, else the nearest centre, within the re-acquisition
+// limits); none when no detection qualifies. Pure: the tracker's rule.
+std::optional<DetectedPerson> ChoosePerson(
+    const std::vector<DetectedPerson>& people,
+    const std::optional<Box>& last_box, const PersonTrackerOptions& options);
+
 struct TrackedFrame {
   bool found = false;       // the person's keypoints are in `person`
   bool reacquired = false;  // found by MultiPose this frame (not followed)
@@ -60,9 +68,6 @@ class PersonTracker {
   bool ended() const { return ended_; }
 
  private:
-  // The detection that continues the track (or starts it), if any.
-  std::optional<DetectedPerson> Choose(
-      const std::vector<DetectedPerson>& people) const;
   // Single pose in the region around `box`.
   DetectedPerson Refine(const RgbImage& frame, const Box& box) const;
 
