@@ -145,6 +145,14 @@ void AddRenderCommand(CLI::App& app, CommandRun* run) {
       ->add_option("--max-zoom", args->replay.render.max_zoom,
                    "Largest zoom of that framing")
       ->capture_default_str();
+  render->add_option(
+      "--beside", args->replay.source_video,
+      "The recording the view's 2D came from (e.g. the video given to "
+      "keypoints): its frames are drawn on the left under the same framing");
+  render
+      ->add_option("--beside-start-s", args->replay.source_video_start_s,
+                   "Time in that video of the clip's frame 0 (s)")
+      ->capture_default_str();
   render->add_flag("--no-shadows", args->no_shadows,
                    "Skip shadows (faster software rendering)");
   render->callback([run, args] { *run = [args] { return RunRender(*args); }; });

@@ -123,6 +123,30 @@ void ImageFromSurface(cairo_surface_t* surface, RgbImage* image) {
   }
 }
 
+RgbImage CropAndScale(const RgbImage& source, double x0_px, double y0_px,
+                      double scale, int width_px, int height_px) {
+  if (!(scale > 0) || width_px <= 0 || height_px <= 0 || source.empty()) {
+    throw std::invalid_argument(
+        "CropAndScale: needs a source, scale > 0 and "
+        "a positive output size");
+  }
+  CairoSurfacePtr from = SurfaceFromImage(source);
+  CairoSurfacePtr to(
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, width_px, height_px));
+  CairoPtr cairo(cairo_create(to.get()));
+  cairo_set_source_rgb(cairo.get(), 0.0, 0.0, 0.0);
+  cairo_paint(cairo.get());
+  cairo_scale(cairo.get(), scale, scale);
+  cairo_translate(cairo.get(), -x0_px, -y0_px);
+  cairo_set_source_surface(cairo.get(), from.get(), 0.0, 0.0);
+  cairo_pattern_set_filter(cairo_get_source(cairo.get()),
+                           CAIRO_FILTER_BILINEAR);
+  cairo_paint(cairo.get());
+  RgbImage result;
+  ImageFromSurface(to.get(), &result);
+  return result;
+}
+
 std::string EncodePng(const RgbImage& image) {
   CairoSurfacePtr surface = SurfaceFromImage(image);
   std::string bytes;

@@ -44,6 +44,13 @@ class RgbImage {
   std::vector<uint8_t> pixels_;
 };
 
+// A window of `source` magnified `scale` times into a width_px x height_px
+// image (bilinear, via cairo): output pixel (u, v) shows the source at
+// (x0_px + u / scale, y0_px + v / scale). Outside the source: black. E.g.
+// the source video beside a render that zooms in on the subject.
+RgbImage CropAndScale(const RgbImage& source, double x0_px, double y0_px,
+                      double scale, int width_px, int height_px);
+
 // PNG bytes of `image` (via cairo).
 std::string EncodePng(const RgbImage& image);
 // Writes `image` as a PNG, atomically.

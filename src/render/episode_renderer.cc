@@ -149,7 +149,7 @@ EpisodeRenderer::EpisodeRenderer(std::shared_ptr<const Character> character,
 }
 
 int EpisodeRenderer::width_px() const {
-  return options_.side_camera ? 2 * panel_width_px_ : panel_width_px_;
+  return (1 + options_.side_camera + options_.source_panel) * panel_width_px_;
 }
 int EpisodeRenderer::height_px() const { return panel_height_px_; }
 
@@ -272,6 +272,39 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
                    margin_px, margin_px, sizes);
   canvas.Finish();
 
+  // Panels left to right: the recording, the render, the free camera.
+  std::vector<RgbImage> panels;
+  if (options_.source_panel) {
+    const RgbImage& source = frame.source_image;
+    if (source.width_px() != image_width_px_ ||
+        source.height_px() != image_height_px_) {
+      throw InputError(
+          "render", where + (source.empty()
+                                 ? ": no frame of the source video"
+                                 : ": the source video's frame is " +
+                                       std::to_string(source.width_px()) + "x" +
+                                       std::to_string(source.height_px()) +
+                                       " px, the clip's image " +
+                                       std::to_string(image_width_px_) + "x" +
+                                       std::to_string(image_height_px_)));
+    }
+    RgbImage shown =
+        CropAndScale(source, corner.x(), corner.y(), zoom * options_.scale,
+                     panel_width_px_, panel_height_px_);
+    OverlayCanvas source_canvas(&shown);
+    source_canvas.DrawSkeleton(
+        *layout_,
+        ScaleKeypoints(CropKeypoints(frame.reference, corner, zoom),
+                       options_.scale),
+        options_.reference_color, sizes);
+    source_canvas.DrawLabel(
+        {{"source video"},
+         {options_.reference_label, options_.reference_color, true}},
+        margin_px, margin_px, sizes);
+    source_canvas.Finish();
+    panels.push_back(std::move(shown));
+  }
+  panels.push_back(std::move(rendered.image));
   if (options_.side_camera) {
     const PinholeCamera side_camera = OrbitCamera(
         options_.side, MeanPoint(pose_world_m, Eigen::Vector3d(0.0, 0.0, 1.0)),
@@ -289,10 +322,15 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
                              sizes);
     side_canvas.DrawLabel({{"free camera"}}, margin_px, margin_px, sizes);
     side_canvas.Finish();
-    RgbImage both(2 * panel_width_px_, panel_height_px_);
-    both.Paste(rendered.image, 0, 0);
-    both.Paste(side, panel_width_px_, 0);
-    rendered.image = std::move(both);
+    panels.push_back(std::move(side));
+  }
+  if (panels.size() == 1) {
+    rendered.image = std::move(panels[0]);
+  } else {
+    rendered.image = RgbImage(width_px(), panel_height_px_);
+    for (size_t p = 0; p < panels.size(); ++p) {
+      rendered.image.Paste(panels[p], static_cast<int>(p) * panel_width_px_, 0);
+    }
   }
   return rendered;
 }
@@ -345,6 +383,56 @@ EpisodeSummary RenderEpisode(FrameSource& source, EpisodeRenderer& renderer,
     summary.video_path = output.video_path;
   }
   return summary;
+}
+
+SourceVideoFrames::SourceVideoFrames(FrameSource& inner,
+                                     const std::string& video_path,
+                                     double clip_fps, double start_s)
+    : inner_(inner),
+      video_path_(video_path),
+      reader_(video_path),
+      clip_fps_(clip_fps),
+      start_s_(start_s) {
+  if (!(clip_fps > 0) || !(reader_.info().fps > 0)) {
+    throw InputError(video_path,
+                     "no frame rate to align the video with the "
+                     "clip (clip " +
+                         std::to_string(clip_fps) + " fps, video " +
+                         std::to_string(reader_.info().fps) + " fps)");
+  }
+}
+
+bool SourceVideoFrames::Next(EpisodeFrame* frame) {
+  // Outline: take the inner frame, read the video forward to the frame
+  // shown at that clip frame's moment, attach it.
+  if (!inner_.Next(frame)) return false;
+  const double time_s = start_s_ + frame->clip_frame / clip_fps_;
+  // Video frame k is shown over [k, k + 1) / fps; the epsilon keeps a clip
+  // frame that falls exactly on a video frame's start on that frame.
+  const int64_t wanted =
+      static_cast<int64_t>(std::floor(time_s * reader_.info().fps + 1e-6));
+  if (wanted < current_index_) {
+    throw InputError(video_path_,
+                     "clip frame " + std::to_string(frame->clip_frame) +
+                         " is earlier than the video frame already shown: "
+                         "frames must come in order");
+  }
+  while (current_index_ < wanted && !ended_) {
+    RgbImage next;
+    if (!reader_.Read(&next)) {
+      ended_ = true;  // past the end: the last frame stays
+      break;
+    }
+    current_ = std::move(next);
+    ++current_index_;
+  }
+  if (current_index_ < 0) {
+    throw InputError(video_path_, time_s < 0
+                                      ? "the clip starts before the video"
+                                      : "the video has no frames");
+  }
+  frame->source_image = current_;
+  return true;
 }
 
 BundleReplaySource::BundleReplaySource(
@@ -411,14 +499,22 @@ EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
   const SimulationOptions simulation;
   std::shared_ptr<const Character> character = LoadCharacterForSimulation(
       options.character_config, options.scene, simulation);
-  BundleReplaySource source(bundle, view_index, character, simulation);
+  BundleReplaySource replay(bundle, view_index, character, simulation);
   EpisodeRenderOptions render = options.render;
-  if (!source.shows_character()) render.pose_label = "3D ground truth";
+  if (!replay.shows_character()) render.pose_label = "3D ground truth";
   const Clip2D& clip = bundle.views[view_index].clip;
+  std::optional<SourceVideoFrames> with_video;
+  if (!options.source_video.empty()) {
+    with_video.emplace(replay, options.source_video, bundle.fps,
+                       options.source_video_start_s);
+    render.source_panel = true;
+  }
   EpisodeRenderer renderer(character, simulation, *clip.layout,
                            clip.image_width_px, clip.image_height_px, render);
   EpisodeOutputOptions output = options.output;
   output.video.fps = bundle.fps;
+  FrameSource& source =
+      with_video ? static_cast<FrameSource&>(*with_video) : replay;
   return RenderEpisode(source, renderer, output);
 }
 

@@ -12,6 +12,7 @@
 
 #include "camera/pinhole.h"
 #include "media/image.h"
+#include "media/video_reader.h"
 #include "media/video_writer.h"
 #include "motion/bundle.h"
 #include "motion/clip2d.h"
@@ -35,6 +36,9 @@ struct EpisodeFrame {
   // e.g. a bundle's ground truth for a skeleton without a character. With a
   // `state` the character's keypoint sites are used and this is ignored.
   std::vector<Eigen::Vector3d> keypoints_world_m;
+  // The recording's own frame at this moment, at the clip's image size
+  // (EpisodeRenderOptions::source_panel); empty: none.
+  RgbImage source_image;
 };
 
 // Where frames come from: a kinematic replay (BundleReplaySource), a policy
@@ -59,6 +63,28 @@ class RecordedFrames : public FrameSource {
   size_t next_ = 0;
 };
 
+// Adds to each frame of `inner` the frame of the recording it was seen in:
+// clip frame t is at start_s + t / clip_fps in the video, which shows there
+// the last video frame that began by then (a 10 fps video holds each frame
+// for three 30 Hz clip frames; past its end, its last frame). Frames must
+// come in order. InputError naming the video when it cannot be read.
+class SourceVideoFrames : public FrameSource {
+ public:
+  SourceVideoFrames(FrameSource& inner, const std::string& video_path,
+                    double clip_fps, double start_s);
+  bool Next(EpisodeFrame* frame) override;
+
+ private:
+  FrameSource& inner_;
+  std::string video_path_;
+  VideoReader reader_;
+  double clip_fps_;
+  double start_s_;
+  RgbImage current_;            // the video frame last read
+  int64_t current_index_ = -1;  // its index; -1 before the first
+  bool ended_ = false;          // the video has no more frames
+};
+
 // How a frame looks.
 struct EpisodeRenderOptions {
   // Output size = the clip's image size x scale, rounded up to even.
@@ -69,6 +95,10 @@ struct EpisodeRenderOptions {
   bool side_camera = false;
   OrbitCameraOptions side;
   bool shadows = true;
+  // A panel on the left: the recording's own frame (EpisodeFrame::
+  // source_image) under the same framing as the render, with the 2D
+  // reference drawn over it; every frame must then carry one.
+  bool source_panel = false;
   // Framing: the view zooms in on the subject (a crop of the reference
   // camera, drawn at full resolution) so that it fills about this share of
   // the frame height, following it smoothly; at most `max_zoom`x, never
@@ -182,6 +212,11 @@ struct BundleReplayOptions {
   std::string character_config;  // e.g. assets/characters/humanoid.yaml
   std::string scene = "flat";
   std::string view;  // view name; empty: the first view
+  // The recording the view's 2D came from, shown beside the render
+  // (SourceVideoFrames); empty: none. `source_video_start_s`: the time in
+  // it of the clip's frame 0.
+  std::string source_video;
+  double source_video_start_s = 0.0;
   EpisodeRenderOptions render;
   EpisodeOutputOptions output;
 };

@@ -153,6 +153,51 @@ TEST_F(EpisodeFrameTest, SideCameraDoublesTheWidth) {
   }
 }
 
+TEST_F(EpisodeFrameTest, SourcePanelShowsTheRecordingUnderTheSameFraming) {
+  EpisodeRenderOptions options;
+  options.scale = 0.5;
+  options.source_panel = true;
+  options.subject_height_fraction = 0.0;  // the whole image: zoom 1
+  EpisodeRenderer renderer(character_, SimulationOptions(),
+                           character_->keypoint_layout(), 640, 480, options);
+  EXPECT_EQ(renderer.width_px(), 640);
+  EpisodeFrame frame;
+  frame.camera = camera_;
+  frame.state = state_;
+  // The recording: blue left half, yellow right half.
+  frame.source_image = RgbImage(640, 480, Rgb{20, 40, 200});
+  for (int y = 0; y < 480; ++y) {
+    for (int x = 320; x < 640; ++x)
+      frame.source_image.set(x, y, {220, 210, 30});
+  }
+  const RenderedFrame rendered = renderer.Render(frame);
+  ASSERT_EQ(rendered.image.width_px(), 640);
+  ASSERT_EQ(rendered.image.height_px(), 240);
+  // Left panel (320 x 240): the recording at half size, away from the
+  // label in the top-left corner and the seam.
+  EXPECT_LE(testing::ColorDistance(rendered.image.at(100, 200), {20, 40, 200}),
+            2);
+  EXPECT_LE(testing::ColorDistance(rendered.image.at(250, 200), {220, 210, 30}),
+            2);
+  // Right panel: the render, the same as without the recording.
+  options.source_panel = false;
+  EpisodeRenderer alone(character_, SimulationOptions(),
+                        character_->keypoint_layout(), 640, 480, options);
+  const RenderedFrame render = alone.Render(frame);
+  int differing = 0;
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      differing += rendered.image.at(320 + x, y) != render.image.at(x, y);
+    }
+  }
+  EXPECT_EQ(differing, 0);
+  // A frame without the recording, or at another size, is named.
+  frame.source_image = RgbImage();
+  EXPECT_THROW(renderer.Render(frame), InputError);
+  frame.source_image = RgbImage(320, 240);
+  EXPECT_THROW(renderer.Render(frame), InputError);
+}
+
 TEST_F(EpisodeFrameTest, MismatchedFramesAreInputErrors) {
   EpisodeRenderer renderer(character_, SimulationOptions(),
                            character_->keypoint_layout(), 640, 480,
@@ -239,6 +284,41 @@ TEST(BundleReplay, SkeletonWithoutCharacterShowsTheGroundTruth) {
   // The reference is the ground truth's exact projection.
   EXPECT_LT(summary.mean_e2d_px, 1e-6);
   EXPECT_EQ(testing::ProbeVideo(summary.video_path).frames, 5);
+}
+
+TEST(SourceVideoFrames, AClipFrameShowsTheVideoFrameOfItsMoment) {
+  // A 10 fps video whose frame k is grey level 20 k, and a 30 Hz clip of
+  // 13 frames starting 0.1 s into it: clip frame t is at 0.1 + t / 30 s,
+  // video frame 1 + t / 3; past the video's last frame (5), it stays.
+  const std::string path = testing::TempDir("source_video") + "/10fps.mp4";
+  Mp4Options video;
+  video.fps = 10.0;
+  video.crf = 0;
+  {
+    Mp4Writer writer(path, 64, 48, video);
+    for (int k = 0; k < 6; ++k) {
+      const uint8_t level = static_cast<uint8_t>(20 * k + 30);
+      writer.Write(RgbImage(64, 48, Rgb{level, level, level}));
+    }
+    writer.Finish();
+  }
+  std::vector<EpisodeFrame> clip(13);
+  for (int t = 0; t < 13; ++t) clip[t].clip_frame = t;
+  RecordedFrames recorded(clip);
+  SourceVideoFrames with_video(recorded, path, 30.0, 0.1);
+  EpisodeFrame frame;
+  for (int t = 0; t < 13; ++t) {
+    ASSERT_TRUE(with_video.Next(&frame));
+    ASSERT_EQ(frame.source_image.width_px(), 64);
+    const int k = std::min(1 + t / 3, 5);
+    EXPECT_NEAR(frame.source_image.at(32, 24).g, 20 * k + 30, 3) << "t " << t;
+  }
+  EXPECT_FALSE(with_video.Next(&frame));
+  // Not a video: named.
+  RecordedFrames again(clip);
+  EXPECT_THROW(
+      SourceVideoFrames(again, testing::SourcePath("README.md"), 30.0, 0.0),
+      InputError);
 }
 
 }  // namespace
