@@ -128,7 +128,7 @@ torch::Tensor ActorCriticImpl::Entropy() const {
 }
 
 PrecisionScope::PrecisionScope(TrainingPrecision precision)
-    : bf16_(precision == TrainingPrecision::kBf16 &&
+    : bf16_(ResolvePrecision(precision) == TrainingPrecision::kBf16 &&
             !at::autocast::is_cpu_enabled()) {
   if (!bf16_) return;
   at::autocast::set_autocast_cpu_dtype(at::kBFloat16);

@@ -124,7 +124,8 @@ void RunTrainBenchmark(const TrainBenchmarkOptions& options) {
       "stepped with no policy, %d env threads)\n\n",
       bound, config.ppo.num_envs, config.run.env_threads);
   std::vector<TrainingPrecision> precisions = options.precisions;
-  if (precisions.empty()) precisions = {config.ppo.training_precision};
+  if (precisions.empty())
+    precisions = {ResolvePrecision(config.ppo.training_precision)};
   std::vector<CollectionMode> collections = options.collections;
   if (collections.empty()) collections = {config.ppo.collection};
   std::vector<Setting> settings;

@@ -1,5 +1,7 @@
 #include "rl/train_config.h"
 
+#include <cpuid.h>
+
 #include "common/error.h"
 #include "common/file_io.h"
 #include "common/settings.h"
@@ -30,12 +32,34 @@ TrackingTaskOptions TrainingTaskOptions(const TrainConfig& config) {
 }
 
 const char* SettingName(TrainingPrecision precision) {
-  return precision == TrainingPrecision::kBf16 ? "bf16" : "fp32";
+  switch (precision) {
+    case TrainingPrecision::kFp32:
+      return "fp32";
+    case TrainingPrecision::kBf16:
+      return "bf16";
+    case TrainingPrecision::kAuto:
+      return "auto";
+  }
+  return "?";
 }
 
 bool ParseSetting(const std::string& text, TrainingPrecision* precision) {
-  return ParseSettingByName(
-      text, {TrainingPrecision::kFp32, TrainingPrecision::kBf16}, precision);
+  return ParseSettingByName(text,
+                            {TrainingPrecision::kFp32, TrainingPrecision::kBf16,
+                             TrainingPrecision::kAuto},
+                            precision);
+}
+
+bool CpuHasAmxBf16() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (!__get_cpuid_count(7, 0, &eax, &ebx, &ecx, &edx)) return false;
+  return (edx >> 22) & 1u;  // CPUID.(EAX=7, ECX=0):EDX[22] = AMX-BF16
+}
+
+TrainingPrecision ResolvePrecision(TrainingPrecision precision) {
+  if (precision != TrainingPrecision::kAuto) return precision;
+  static const bool amx = CpuHasAmxBf16();
+  return amx ? TrainingPrecision::kBf16 : TrainingPrecision::kFp32;
 }
 
 const char* SettingName(CollectionMode mode) {

@@ -126,6 +126,11 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.initial_states = task.initial_states;
   spdlog::info("{} initial-state buffers for {} views",
                s.initial_states->num_buffers(), s.reference->views().size());
+  if (config.ppo.training_precision == TrainingPrecision::kAuto) {
+    spdlog::info("training precision auto: {} (AMX-BF16 {})",
+                 SettingName(ResolvePrecision(config.ppo.training_precision)),
+                 CpuHasAmxBf16() ? "present" : "absent");
+  }
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);

@@ -135,7 +135,9 @@ void ExpectTheWalkIsLearned(
   EXPECT_GT(after.mean_frames,
             before.mean_frames * thresholds.min_survival_gain);
   EXPECT_GT(after.mean_frames, thresholds.min_trained_frames);
-  if (thresholds.e2d_must_fall) EXPECT_LT(after.e2d_px, before.e2d_px);
+  if (thresholds.e2d_must_fall) {
+    EXPECT_LT(after.e2d_px, before.e2d_px);
+  }
 }
 
 TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {

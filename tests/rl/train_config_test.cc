@@ -144,8 +144,23 @@ TEST(TrainConfig, EveryShippedConfigLoadsAndValidates) {
   EXPECT_GE(loaded, 3);  // walk, walk2d, walk2d_fast
   TrainConfig fast = LoadTrainConfig(std::string(MIMIC2D_SOURCE_DIR) +
                                      "/configs/walk2d_fast.yaml");
-  EXPECT_EQ(fast.ppo.training_precision, TrainingPrecision::kBf16);
+  EXPECT_EQ(fast.ppo.training_precision, TrainingPrecision::kAuto);
   EXPECT_EQ(fast.ppo.batch_size(), 2048);
+}
+
+TEST(TrainConfig, AutoPrecisionIsBf16OnlyWithAmx) {
+  TrainingPrecision precision = TrainingPrecision::kFp32;
+  ASSERT_TRUE(ParseSetting("auto", &precision));
+  EXPECT_EQ(precision, TrainingPrecision::kAuto);
+  EXPECT_EQ(
+      ResolvePrecision(TrainingPrecision::kAuto),
+      CpuHasAmxBf16() ? TrainingPrecision::kBf16 : TrainingPrecision::kFp32);
+  // An explicit choice is kept whatever the CPU.
+  EXPECT_EQ(ResolvePrecision(TrainingPrecision::kBf16),
+            TrainingPrecision::kBf16);
+  EXPECT_EQ(ResolvePrecision(TrainingPrecision::kFp32),
+            TrainingPrecision::kFp32);
+  EXPECT_STREQ(SettingName(TrainingPrecision::kAuto), "auto");
 }
 
 TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
