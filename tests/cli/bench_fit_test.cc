@@ -9,29 +9,15 @@
 #include <sstream>
 #include <string>
 
+#include "cli/cli_test_util.h"
 #include "common/file_io.h"
 #include "test_paths.h"
 
 namespace m2d {
 namespace {
 
-struct BenchResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-BenchResult RunMimic2d(const std::string& arguments) {
-  const std::string command =
-      std::string(MIMIC2D_BINARY) + " " + arguments + " 2>&1";
-  BenchResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe) != nullptr)
-    result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using BenchResult = testing::CommandResult;
+using testing::RunMimic2d;
 
 // The table line that starts with `prefix`, or "".
 std::string LineStartingWith(const std::string& text,

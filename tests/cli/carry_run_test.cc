@@ -1,13 +1,12 @@
 // scripts/carry_run.sh: an unfinished training travels through git.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "cli/cli_test_util.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -15,10 +14,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct ScriptResult {
-  int exit_code = -1;
-  std::string output;
-};
+using testing::CommandResult;
 
 // The script works from the folder above its own, so a copy in
 // <root>/scripts/ carries runs of <root>, never the repository's.
@@ -32,17 +28,9 @@ class CarryRunTest : public ::testing::Test {
                   root_ + "/scripts/carry_run.sh");
   }
 
-  ScriptResult Run(const std::string& arguments) const {
-    const std::string command =
-        "bash " + root_ + "/scripts/carry_run.sh " + arguments + " 2>&1";
-    ScriptResult result;
-    FILE* pipe = popen(command.c_str(), "r");
-    char buffer[4096];
-    while (fgets(buffer, sizeof(buffer), pipe) != nullptr)
-      result.output += buffer;
-    const int status = pclose(pipe);
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
+  CommandResult Run(const std::string& arguments) const {
+    return testing::RunCommand("bash " + root_ + "/scripts/carry_run.sh " +
+                               arguments);
   }
 
   // A run folder whose log's last row is at `samples`.
@@ -66,14 +54,14 @@ class CarryRunTest : public ::testing::Test {
 
 TEST_F(CarryRunTest, SavesAndRestoresWhatResumeNeeds) {
   MakeRun(root_ + "/runs/demo", 4096);
-  ScriptResult saved = Run("save demo");
+  CommandResult saved = Run("save demo");
   ASSERT_EQ(saved.exit_code, 0) << saved.output;
   EXPECT_NE(saved.output.find("4096 samples"), std::string::npos)
       << saved.output;
   EXPECT_EQ(Read(root_ + "/assets/runs/demo/checkpoint.pt"), "weights 4096");
   // A new machine: runs/ is gone; restore brings the three files back.
   fs::remove_all(root_ + "/runs");
-  ScriptResult restored = Run("restore demo");
+  CommandResult restored = Run("restore demo");
   ASSERT_EQ(restored.exit_code, 0) << restored.output;
   for (const char* file : {"checkpoint.pt", "train_log.csv", "config.yaml"}) {
     EXPECT_EQ(Read(root_ + "/runs/demo/" + file),
@@ -89,7 +77,7 @@ TEST_F(CarryRunTest, SavesAndRestoresWhatResumeNeeds) {
 TEST_F(CarryRunTest, RestoreNeverReplacesARunThatTrainedFurther) {
   MakeRun(root_ + "/assets/runs/demo", 4096);
   MakeRun(root_ + "/runs/demo", 8192);
-  ScriptResult refused = Run("restore demo");
+  CommandResult refused = Run("restore demo");
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.output.find("has trained further"), std::string::npos)
       << refused.output;
@@ -97,7 +85,7 @@ TEST_F(CarryRunTest, RestoreNeverReplacesARunThatTrainedFurther) {
 }
 
 TEST_F(CarryRunTest, MissingFilesAndBadUsageAreNamed) {
-  ScriptResult missing = Run("save nothing");
+  CommandResult missing = Run("save nothing");
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("runs/nothing/checkpoint.pt not found"),
             std::string::npos)

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cli/cli_test_util.h"
 #include "common/file_io.h"
 #include "motion/bundle.h"
 #include "motion/clip_io.h"
@@ -17,22 +18,8 @@
 namespace m2d {
 namespace {
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult RunMimic2d(const std::string& arguments) {
-  std::string command = std::string(MIMIC2D_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe) != nullptr)
-    result.output += buffer;
-  int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing::CommandResult;
+using testing::RunMimic2d;
 
 std::string WriteFile(const std::string& dir, const std::string& name,
                       const std::string& text) {
