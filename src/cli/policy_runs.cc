@@ -223,20 +223,8 @@ EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
   const Clip2D& clip = bundle.views[view_index].clip;
   EpisodeRenderOptions render = replay.render;
   render.pose_label = "character (policy)";
-  std::optional<SourceVideoFrames> with_video;
-  if (!replay.source_video.empty()) {
-    with_video.emplace(frames, replay.source_video, bundle.fps,
-                       replay.source_video_start_s);
-    render.source_panel = true;
-  }
-  EpisodeRenderer renderer(character, config.env.simulation,
-                           character->keypoint_layout(), clip.image_width_px,
-                           clip.image_height_px, render);
-  EpisodeOutputOptions output = replay.output;
-  output.video.fps = bundle.fps;
-  FrameSource& source =
-      with_video ? static_cast<FrameSource&>(*with_video) : frames;
-  return RenderEpisode(source, renderer, output);
+  return RenderViewFrames(frames, character, config.env.simulation, clip,
+                          bundle.fps, render, replay);
 }
 
 }  // namespace m2d::cli

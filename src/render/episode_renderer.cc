@@ -503,18 +503,28 @@ EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
   EpisodeRenderOptions render = options.render;
   if (!replay.shows_character()) render.pose_label = "3D ground truth";
   const Clip2D& clip = bundle.views[view_index].clip;
+  return RenderViewFrames(replay, character, simulation, clip, bundle.fps,
+                          render, options);
+}
+
+EpisodeSummary RenderViewFrames(FrameSource& frames,
+                                std::shared_ptr<const Character> character,
+                                const SimulationOptions& simulation,
+                                const Clip2D& clip, double fps,
+                                EpisodeRenderOptions render,
+                                const BundleReplayOptions& options) {
   std::optional<SourceVideoFrames> with_video;
   if (!options.source_video.empty()) {
-    with_video.emplace(replay, options.source_video, bundle.fps,
+    with_video.emplace(frames, options.source_video, fps,
                        options.source_video_start_s);
     render.source_panel = true;
   }
-  EpisodeRenderer renderer(character, simulation, *clip.layout,
+  EpisodeRenderer renderer(std::move(character), simulation, *clip.layout,
                            clip.image_width_px, clip.image_height_px, render);
   EpisodeOutputOptions output = options.output;
-  output.video.fps = bundle.fps;
+  output.video.fps = fps;
   FrameSource& source =
-      with_video ? static_cast<FrameSource&>(*with_video) : replay;
+      with_video ? static_cast<FrameSource&>(*with_video) : frames;
   return RenderEpisode(source, renderer, output);
 }
 

@@ -221,6 +221,16 @@ struct BundleReplayOptions {
   EpisodeOutputOptions output;
 };
 
+// Draws `frames` of a view whose 2D is `clip` at `fps` and writes the
+// outputs of `options`, with the recording beside them when
+// `options.source_video` is set: the shared tail of a replay and a rollout.
+EpisodeSummary RenderViewFrames(FrameSource& frames,
+                                std::shared_ptr<const Character> character,
+                                const SimulationOptions& simulation,
+                                const Clip2D& clip, double fps,
+                                EpisodeRenderOptions render,
+                                const BundleReplayOptions& options);
+
 // Replays `bundle` kinematically (BundleReplaySource) and writes the
 // outputs; the one call for `mimic2d render` and the demo.
 EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
