@@ -12,6 +12,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # libqhull-dev: mujoco's CMake target names /usr/include/libqhull_r
   libmujoco-dev libqhull-dev libtorch-dev libceres-dev libassimp-dev assimp-testmodels
+  # libopencv-ml-dev: expectation-maximization for the fit's pose prior
+  libopencv-ml-dev
   # libopenblas0-openmp: LibTorch's libblas.so.3; 4x faster PPO updates than
   # ATLAS here, and it follows LibTorch's thread setting (docs/benchmarks.md)
   libopenblas0-openmp

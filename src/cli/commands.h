@@ -20,6 +20,7 @@ void AddReportCommand(CLI::App& app, CommandRun* run);
 void AddTrainCommand(CLI::App& app, CommandRun* run);
 void AddEvalCommand(CLI::App& app, CommandRun* run);
 void AddFitCommand(CLI::App& app, CommandRun* run);
+void AddPriorCommand(CLI::App& app, CommandRun* run);
 void AddKeypointsCommand(CLI::App& app, CommandRun* run);
 void AddBenchCommand(CLI::App& app, CommandRun* run);
 // `gen train` and `generate`.

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   m2d::cli::AddTrainCommand(app, &run);
   m2d::cli::AddEvalCommand(app, &run);
   m2d::cli::AddFitCommand(app, &run);
+  m2d::cli::AddPriorCommand(app, &run);
   m2d::cli::AddKeypointsCommand(app, &run);
   m2d::cli::AddBenchCommand(app, &run);
   m2d::cli::AddGenCommands(app, &run);

@@ -15,8 +15,16 @@
 
 #include "fit/camera_model.h"
 #include "fit/kinematics.h"
+#include "fit/pose_prior.h"
 
 namespace m2d {
+
+// The value of a number or of a Jet, without its derivatives.
+inline double ScalarPart(double x) { return x; }
+template <typename T, int N>
+double ScalarPart(const ceres::Jet<T, N>& x) {
+  return x.a;
+}
 
 // Per-coordinate Geman-McClure as a residual: its square is SMPLify's GMoF
 // sigma^2 x^2 / (sigma^2 + x^2); smooth, ~x near 0, bounded by sigma.
@@ -82,11 +90,15 @@ struct LimbCost {
   double inv_scale_px = 1.0;
   double sigma = 0.5;
   double penetration_weight = 0.0;
-  double prior_weight = 0.0;
+  double prior_weight = 0.0;  // toward rest, per rad
+  // The learned prior's marginal over the limb's hinges (null: toward
+  // rest), weighted per standard deviation as MixturePriorCost.
+  const PoseMixture* limb_mixture = nullptr;
+  double mixture_weight = 0.0;
 
   int NumResiduals() const {
     return 2 * static_cast<int>(keypoints.size()) + model->num_sole_points() +
-           static_cast<int>(limb_hinges.size());
+           static_cast<int>(limb_hinges.size()) + 1;
   }
 
   template <typename T>
@@ -119,8 +131,27 @@ struct LimbCost {
       const T& z = points[3 * (first_sole + s) + 2];
       *out = z < T(0) ? T(penetration_weight) * z : T(0);
     }
-    for (size_t i = 0; i < limb_hinges.size(); ++i, ++out)
-      *out = T(prior_weight) * blocks[0][i];
+    const int num_limb_hinges = static_cast<int>(limb_hinges.size());
+    if (limb_mixture == nullptr) {
+      for (int i = 0; i < num_limb_hinges; ++i, ++out)
+        *out = T(prior_weight) * blocks[0][i];
+      *out = T(0);
+      return true;
+    }
+    // The best component at the current angles, held for the derivative.
+    double angles[kMaxHinges];
+    for (int i = 0; i < num_limb_hinges; ++i)
+      angles[i] = ScalarPart(blocks[0][i]);
+    const int k = limb_mixture->BestComponent(angles);
+    const Eigen::MatrixXd& factor = limb_mixture->precision_factors[k];
+    for (int r = 0; r < num_limb_hinges; ++r, ++out) {
+      T sum(0);
+      for (int c = r; c < num_limb_hinges; ++c)
+        sum += factor(r, c) * (blocks[0][c] - T(limb_mixture->means[k][c]));
+      *out = T(mixture_weight) * sum;
+    }
+    *out =
+        T(mixture_weight * std::sqrt(2.0 * limb_mixture->component_costs[k]));
     return true;
   }
 

@@ -9,11 +9,15 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
+#include <optional>
 
 #include "common/error.h"
 #include "fit/camera_model.h"
 #include "fit/costs.h"
 #include "fit/kinematics.h"
+#include "fit/pose_prior.h"
+#include "fit/pose_prior_training.h"
 #include "motion/canonical.h"
 #include "sim/character.h"
 #include "sim/pose_mapping.h"
@@ -149,6 +153,37 @@ double FocalPriorPx(const FitOptions& options, const Observations& obs) {
   return options.fixed_focal_px > 0
              ? options.fixed_focal_px
              : std::hypot(static_cast<double>(obs.width_px), obs.height_px);
+}
+
+// What the fit assumes beyond the 2D: the focal length's prior and the
+// learned pose prior (null: the pull toward rest).
+struct FitPriors {
+  double focal_px = 0.0;
+  std::shared_ptr<const PoseMixture> pose_mixture;
+  std::string pose_prior_name = "rest";  // for the summary
+};
+
+FitPriors MakeFitPriors(const Character& character, const FitOptions& options,
+                        const Observations& obs, const std::string& source) {
+  FitPriors priors;
+  priors.focal_px = FocalPriorPx(options, obs);
+  const std::string& path = character.config().pose_prior_path;
+  if (options.pose_prior == PosePriorKind::kRest ||
+      (options.pose_prior == PosePriorKind::kAuto && path.empty())) {
+    return priors;
+  }
+  if (path.empty()) {
+    throw InputError(source, "pose_prior is mixture but character '" +
+                                 character.name() +
+                                 "' names no pose_prior in its config");
+  }
+  auto mixture = std::make_shared<PoseMixture>(ReadPoseMixture(path));
+  CheckPoseMixtureHinges(*mixture, HingeNames(character), path);
+  priors.pose_mixture = std::move(mixture);
+  priors.pose_prior_name =
+      "mixture of " + std::to_string(priors.pose_mixture->num_components()) +
+      " (" + path.substr(path.find_last_of('/') + 1) + ")";
+  return priors;
 }
 
 // Every estimated quantity. Vectors are sized once, so block pointers stay
@@ -459,7 +494,7 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
 // them out).
 void BuildProblem(Stage stage, const Observations& obs,
                   const KinematicModel& model, const KeypointLayout& layout,
-                  const FitOptions& options, double focal_prior_px,
+                  const FitOptions& options, const FitPriors& priors,
                   const ContactWeights* contacts, Parameters& params,
                   ceres::Problem& problem) {
   const int num_frames = obs.num_frames;
@@ -509,9 +544,18 @@ void BuildProblem(Stage stage, const Observations& obs,
       problem.SetParameterBlockConstant(hinges);
       continue;
     }
-    problem.AddResidualBlock(
-        PriorCost::Create(num_hinges, options.pose_prior_weight), nullptr,
-        {hinges});
+    if (priors.pose_mixture != nullptr) {
+      problem.AddResidualBlock(
+          new MixturePriorCost(priors.pose_mixture.get(),
+                               stage == Stage::kPoseWithContacts
+                                   ? options.pose_mixture_final_weight
+                                   : options.pose_mixture_weight),
+          nullptr, hinges);
+    } else {
+      problem.AddResidualBlock(
+          PriorCost::Create(num_hinges, options.pose_prior_weight), nullptr,
+          {hinges});
+    }
     if (t >= 1 && t + 1 < num_frames) {
       problem.AddResidualBlock(
           AccelerationCost::Create(num_hinges, options.pose_smooth_weight),
@@ -557,11 +601,12 @@ void BuildProblem(Stage stage, const Observations& obs,
       problem.SetParameterBlockConstant(&params.focal_px);
     } else {
       problem.AddResidualBlock(
-          FocalPriorCost::Create(focal_prior_px, options.focal_prior_weight),
+          FocalPriorCost::Create(priors.focal_px, options.focal_prior_weight),
           nullptr, &params.focal_px);
-      problem.SetParameterLowerBound(&params.focal_px, 0, 0.1 * focal_prior_px);
+      problem.SetParameterLowerBound(&params.focal_px, 0,
+                                     0.1 * priors.focal_px);
       problem.SetParameterUpperBound(&params.focal_px, 0,
-                                     20.0 * focal_prior_px);
+                                     20.0 * priors.focal_px);
     }
     // Most footage is shot level (a tripod, a person holding a phone
     // upright); without this a body's sideways lean hides in camera roll.
@@ -617,7 +662,7 @@ struct StageResult {
 StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
                        const KinematicModel& model,
                        const KeypointLayout& layout, const FitOptions& options,
-                       double focal_prior_px, const ContactWeights* contacts,
+                       const FitPriors& priors, const ContactWeights* contacts,
                        Parameters& params) {
   // CHOLMOD's supernodal factorization opens an OpenMP region per
   // supernode; on systems this small its threads spent 82 % of a fit's CPU
@@ -630,8 +675,8 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
     ~RestoreOpenMpThreads() { omp_set_num_threads(threads); }
   } restore{saved_openmp_threads};
   ceres::Problem problem;
-  BuildProblem(stage, obs, model, layout, options, focal_prior_px, contacts,
-               params, problem);
+  BuildProblem(stage, obs, model, layout, options, priors, contacts, params,
+               problem);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = max_iterations;
@@ -654,7 +699,7 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
 // depth-mirrored solutions from one frame to the next.
 void SearchLimbs(const Observations& obs, const KinematicModel& model,
                  const std::vector<Limb>& limbs, const FitOptions& options,
-                 Parameters& params) {
+                 const FitPriors& priors, Parameters& params) {
   constexpr int kMaxCandidates = 5;
   constexpr double kDistinctRad = 0.15;  // closer candidates are one
   constexpr double kSwitchWeight = 0.3;  // per rad of change per frame
@@ -670,6 +715,9 @@ void SearchLimbs(const Observations& obs, const KinematicModel& model,
     std::vector<double> values;  // the limb's hinges
   };
   for (const Limb& limb : limbs) {
+    std::optional<PoseMixture> limb_mixture;
+    if (priors.pose_mixture != nullptr)
+      limb_mixture = priors.pose_mixture->Marginal(limb.hinges);
     std::vector<std::vector<Candidate>> candidates(num_frames);
     for (int t = 0; t < num_frames; ++t) {
       std::vector<double> current;
@@ -702,6 +750,10 @@ void SearchLimbs(const Observations& obs, const KinematicModel& model,
       cost.sigma = options.reprojection_sigma;
       cost.penetration_weight = options.penetration_weight;
       cost.prior_weight = options.pose_prior_weight;
+      if (limb_mixture.has_value()) {
+        cost.limb_mixture = &*limb_mixture;
+        cost.mixture_weight = options.pose_mixture_weight;
+      }
       std::vector<double> angles = current;
       ceres::Problem problem;
       problem.AddResidualBlock(LimbCost::Create(std::move(cost)), nullptr,
@@ -828,7 +880,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
                                 const KeypointLayout& layout,
                                 const Character& character,
                                 const FitOptions& options,
-                                double focal_prior_px,
+                                const FitPriors& priors,
                                 std::chrono::steady_clock::time_point started,
                                 FitSummary summary, Parameters& best) {
   auto say = [&](const std::string& line) {
@@ -837,7 +889,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   // Stage 2 continues: the full pose.
   StageResult pose =
       SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
-                 layout, options, focal_prior_px, nullptr, best);
+                 layout, options, priors, nullptr, best);
   summary.iterations += pose.iterations;
   say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
       " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
@@ -862,7 +914,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
         FramePoints(best, model), model, options, obs.fps, true);
     final_stage =
         SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
-                   model, layout, options, focal_prior_px, &contacts, best);
+                   model, layout, options, priors, &contacts, best);
     summary.iterations += final_stage.iterations;
     say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
         std::to_string(final_stage.initial_cost) + " -> " +
@@ -933,7 +985,7 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
       ReadCharacterObservations(clip, character, options, source);
   const RestPose rest = MakeRestPose(model, *clip.layout);
   const std::vector<Limb> limbs = FindLimbs(model);
-  const double focal_prior_px = FocalPriorPx(options, obs);
+  const FitPriors priors = MakeFitPriors(character, options, obs, source);
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
@@ -942,6 +994,7 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   summary.camera_model = CameraMotionName(options.camera_motion);
   summary.focal_fixed = options.fixed_focal_px > 0;
   summary.num_frames = obs.num_frames;
+  summary.pose_prior = priors.pose_prior_name;
 
   // Stages 1 and 2, from each facing start: the camera and root to
   // convergence, then a short full-pose solve; the start with the lowest
@@ -954,14 +1007,14 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   for (int k = 0; k < options.num_facing_starts; ++k) {
     const double turn_deg = 360.0 * k / options.num_facing_starts;
     Parameters params =
-        InitialParameters(obs, model, rest, options, focal_prior_px,
+        InitialParameters(obs, model, rest, options, priors.focal_px,
                           M_PI + turn_deg * M_PI / 180.0);
     const StageResult root =
         SolveStage(Stage::kRoot, options.root_stage_iterations, obs, model,
-                   *clip.layout, options, focal_prior_px, nullptr, params);
+                   *clip.layout, options, priors, nullptr, params);
     const StageResult screen =
         SolveStage(Stage::kPose, options.screening_iterations, obs, model,
-                   *clip.layout, options, focal_prior_px, nullptr, params);
+                   *clip.layout, options, priors, nullptr, params);
     summary.iterations += root.iterations + screen.iterations;
     char line[200];
     std::snprintf(line, sizeof(line),
@@ -984,12 +1037,12 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
 
   // Stage 1b: each limb searched from a grid of starts, frame by frame.
   if (options.limb_search_iterations > 0) {
-    SearchLimbs(obs, model, limbs, options, best);
+    SearchLimbs(obs, model, limbs, options, priors, best);
     say("stage 1b (limb search): " + std::to_string(limbs.size()) + " limbs, " +
         std::to_string(obs.num_frames) + " frames");
   }
   return SolvePoseAndReport(obs, model, *clip.layout, character, options,
-                            focal_prior_px, started, summary, best);
+                            priors, started, summary, best);
 }
 
 ViewEstimate RefineView(const Clip2D& clip, const Character& character,
@@ -1017,7 +1070,7 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                                  " cameras; expected 1 or one per frame");
   }
   const PinholeCamera& camera = cameras.front();
-  const double focal_prior_px = FocalPriorPx(options, obs);
+  const FitPriors priors = MakeFitPriors(character, options, obs, source);
   Parameters params;
   params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
                                                : camera.intrinsics().fx_px;
@@ -1061,12 +1114,13 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
   summary.focal_fixed = options.fixed_focal_px > 0;
   summary.num_frames = obs.num_frames;
   summary.initialization = "the given camera and poses";
+  summary.pose_prior = priors.pose_prior_name;
   // The start's cost under stage 2's objective (no iterations).
   summary.initial_cost = SolveStage(Stage::kPose, 0, obs, model, *clip.layout,
-                                    options, focal_prior_px, nullptr, params)
+                                    options, priors, nullptr, params)
                              .initial_cost;
   return SolvePoseAndReport(obs, model, *clip.layout, character, options,
-                            focal_prior_px, started, summary, params);
+                            priors, started, summary, params);
 }
 
 ReferenceBundle FitBundle(

@@ -34,6 +34,25 @@ inline bool ParseSetting(const std::string& text, CameraMotion* motion) {
 }
 inline std::string SettingChoices(CameraMotion) { return "static, moving"; }
 
+// The fit's pose prior: the character's learned mixture over its hinge
+// angles (fit/pose_prior.h, its config's `pose_prior`), or a pull toward the
+// rest pose; auto takes the mixture when the character has one.
+enum class PosePriorKind { kAuto, kMixture, kRest };
+inline const char* SettingName(PosePriorKind kind) {
+  return kind == PosePriorKind::kMixture ? "mixture"
+         : kind == PosePriorKind::kRest  ? "rest"
+                                         : "auto";
+}
+inline bool ParseSetting(const std::string& text, PosePriorKind* kind) {
+  return ParseSettingByName(
+      text,
+      {PosePriorKind::kAuto, PosePriorKind::kMixture, PosePriorKind::kRest},
+      kind);
+}
+inline std::string SettingChoices(PosePriorKind) {
+  return "auto, mixture, rest";
+}
+
 struct FitOptions {
   CameraMotion camera_motion = CameraMotion::kStatic;
   // > 0: the focal length is known (pixels) and held fixed; 0: estimated,
@@ -51,7 +70,15 @@ struct FitOptions {
   // Weights of the terms (docs/fit.md, "Objective"), applied to residuals
   // (a cost term is 1/2 weight^2 residual^2). Residual units are in the
   // comments.
-  double pose_prior_weight = 0.05;      // per hinge angle (rad) from rest
+  PosePriorKind pose_prior = PosePriorKind::kAuto;
+  double pose_prior_weight = 0.05;  // per hinge angle (rad) from rest
+  // The learned prior's weight, per standard deviation of its best
+  // component (its cost is weight^2 x the mixture's negative
+  // log-likelihood; docs/fit.md for the value).
+  double pose_mixture_weight = 0.05;
+  // The same in stage 3 (contacts): SMPLify's schedule lowers the prior
+  // once the pose is in the right basin, so the 2D has the last word.
+  double pose_mixture_final_weight = 0.02;
   double pose_smooth_weight = 4.0;      // hinge acceleration, rad per frame^2
   double root_smooth_weight = 20.0;     // root acceleration, m per frame^2
   double turn_smooth_weight = 8.0;      // root angular accel., rad per frame^2
@@ -119,6 +146,12 @@ struct FitOptions {
       "keypoints below this confidence are ignored");
     v("reprojection_sigma", self.reprojection_sigma, Range::Above(0),
       "Geman-McClure sigma of the 2D term, in person sizes");
+    v("pose_prior", self.pose_prior, Range::Any(),
+      "the character's learned pose mixture, or toward rest");
+    v("pose_mixture_weight", self.pose_mixture_weight, weight,
+      "learned prior, per standard deviation");
+    v("pose_mixture_final_weight", self.pose_mixture_final_weight, weight,
+      "learned prior in stage 3 (contacts)");
     v("pose_prior_weight", self.pose_prior_weight, weight,
       "per hinge angle (rad) from rest");
     v("pose_smooth_weight", self.pose_smooth_weight, weight,

@@ -110,6 +110,7 @@ nlohmann::json SummaryToJson(const FitSummary& summary) {
   return {{"camera_model", summary.camera_model},
           {"focal_fixed", summary.focal_fixed},
           {"initialization", summary.initialization},
+          {"pose_prior", summary.pose_prior},
           {"num_frames", summary.num_frames},
           {"iterations", summary.iterations},
           {"initial_cost", summary.initial_cost},
@@ -124,6 +125,9 @@ FitSummary SummaryFromJson(const JsonCursor& cursor) {
   summary.camera_model = cursor.Field("camera_model").String();
   summary.focal_fixed = cursor.Field("focal_fixed").Boolean();
   summary.initialization = cursor.Field("initialization").String();
+  // Bundles fitted before the learned prior (format 3) lack it.
+  if (cursor.Has("pose_prior"))
+    summary.pose_prior = cursor.Field("pose_prior").String();
   summary.num_frames = static_cast<int>(cursor.Field("num_frames").Integer());
   summary.iterations = static_cast<int>(cursor.Field("iterations").Integer());
   summary.initial_cost = cursor.Field("initial_cost").Number();
@@ -390,6 +394,7 @@ std::string FitSummary::BriefReport() const {
       camera_model.c_str(), focal_fixed ? "fixed" : "estimated",
       initialization.empty() ? "-" : initialization.c_str(), num_frames);
   report += line;
+  if (!pose_prior.empty()) report += "pose prior: " + pose_prior + "\n";
   std::snprintf(line, sizeof(line),
                 "%d iterations, cost %.6g -> %.6g, mean reprojection %.2f px, "
                 "%.1f s\n",

@@ -45,6 +45,7 @@ struct FitSummary {
   std::string camera_model;    // "static" or "moving"
   bool focal_fixed = false;    // --focal given: focal length not estimated
   std::string initialization;  // which start won (e.g. "facing 180 deg")
+  std::string pose_prior;      // "rest" or the learned mixture's file
   int num_frames = 0;
   int iterations = 0;  // solver iterations over every stage
   double initial_cost = 0.0;

@@ -85,13 +85,14 @@ CharacterConfig LoadCharacterConfig(const std::string& yaml_path) {
   YamlSection root(ReadYamlFile(yaml_path), yaml_path, "");
   CharacterConfig config;
   config.source_path = yaml_path;
-  std::string skeleton, keypoint_map;
+  std::string skeleton, keypoint_map, pose_prior;
   std::map<std::string, std::string> scenes;
   std::map<std::string, YAML::Node> joints;
   root.Optional("name", &config.name);
   root.Optional("skeleton", &skeleton);
   root.Optional("keypoint_map", &keypoint_map);
   root.Optional("keypoint_site_prefix", &config.keypoint_site_prefix);
+  root.Optional("pose_prior", &pose_prior);
   root.Optional("scenes", &scenes);
   root.Optional("joints", &joints);
   root.Optional("ground_contact_bodies", &config.ground_contact_bodies);
@@ -103,6 +104,8 @@ CharacterConfig LoadCharacterConfig(const std::string& yaml_path) {
   if (!keypoint_map.empty()) {
     config.keypoint_map_path = ResolvePath(yaml_path, keypoint_map);
   }
+  if (!pose_prior.empty())
+    config.pose_prior_path = ResolvePath(yaml_path, pose_prior);
   for (const auto& [scene, path] : scenes) {
     config.scene_paths[scene] = ResolvePath(yaml_path, path);
   }

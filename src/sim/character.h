@@ -32,6 +32,9 @@ struct CharacterConfig {
   std::string skeleton_path;
   std::string keypoint_map_path;
   std::string keypoint_site_prefix = "kp_";
+  // Optional: the learned pose prior the fit uses (fit/pose_prior.h); empty
+  // when the character has none.
+  std::string pose_prior_path;
   std::map<std::string, std::string> scene_paths;  // scene name -> MJCF
   std::vector<JointBinding> joints;
   std::vector<std::string> ground_contact_bodies;

@@ -15,6 +15,7 @@
 #include "eval/metrics.h"
 #include "fit/camera_model.h"
 #include "fit/costs.h"
+#include "fit/fit_test_util.h"
 #include "fit/kinematics.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
@@ -24,14 +25,8 @@
 namespace m2d {
 namespace {
 
+using testing::Humanoid;
 using testing::SourcePath;
-
-std::shared_ptr<const Character> Humanoid() {
-  static std::shared_ptr<const Character> character =
-      LoadCharacterForSimulation(SourcePath("assets/characters/humanoid.yaml"),
-                                 "flat", SimulationOptions());
-  return character;
-}
 
 // Random hinge angles within their ranges and a random root.
 struct RandomPose {
@@ -382,6 +377,9 @@ TEST(Fit, RecoversAKnownStaticCameraAndThePoses) {
     EXPECT_NEAR(angles[1], true_angles[1], 5 * M_PI / 180);
     EXPECT_LT(estimate.summary.mean_reprojection_px, 8.0);
     EXPECT_LT(error_m, 0.08);
+    // The humanoid ships its learned pose prior; auto takes it.
+    EXPECT_EQ(estimate.summary.pose_prior.rfind("mixture of 8", 0), 0u)
+        << estimate.summary.pose_prior;
   }
 }
 
@@ -463,7 +461,11 @@ TEST(Fit, RefiningFromTheTruthStartsAtIt) {
     EXPECT_LT(error_m, max_error_m) << iterations << " iterations";
     EXPECT_NEAR(angles[0], true_angles[0], max_pitch_deg * M_PI / 180)
         << iterations << " iterations";
-    EXPECT_NEAR(angles[1], true_angles[1], 3 * M_PI / 180);
+    // The learned pose prior moves the objective's minimum a little off
+    // the truth (3.2 deg of roll after 50 iterations; the bound was 3).
+    const double max_roll_deg = iterations == 1 ? 3.0 : 4.5;
+    EXPECT_NEAR(angles[1], true_angles[1], max_roll_deg * M_PI / 180)
+        << iterations << " iterations";
   }
 
   const std::vector<Pose3D> too_few(truth.begin(), truth.end() - 1);
@@ -519,6 +521,20 @@ TEST(Fit, RejectsInputItCannotUseWithANamedError) {
   for (int t = 0; t < faint.num_frames(); ++t)
     for (int j = 3; j < 17; ++j) faint.keypoints.at(t, j).confidence = 0.05;
   expect_error(faint, "frames have");
+  // A learned prior asked of a character that has none.
+  CharacterConfig bare_config =
+      LoadCharacterConfig(SourcePath("assets/characters/humanoid.yaml"));
+  bare_config.pose_prior_path.clear();
+  auto bare = Character::Build(bare_config, "flat", 1.0 / 120);
+  options.pose_prior = PosePriorKind::kMixture;
+  try {
+    FitView(good, *bare, options, "clip.json");
+    ADD_FAILURE() << "no error for a missing pose prior";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("names no pose_prior"),
+              std::string::npos)
+        << e.what();
+  }
   // Settings are checked too.
   FitOptions bad;
   bad.fixed_focal_px = -5;
