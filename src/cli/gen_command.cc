@@ -214,6 +214,7 @@ int RunGenEval(const GenEvalArgs& args) {
         {"reconstruction_scale_error", result.reconstruction_scale_error},
         {"decode_context_codes", args.options.decoding.context_codes},
         {"lookahead_codes", args.options.decoding.lookahead_codes},
+        {"emit_codes", args.options.decoding.emit_codes},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},
         {"real_windows", result.real_windows},
@@ -281,7 +282,9 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    eval_args->options.decoding.context_codes,
                    "Codes the streaming decoder sees per step");
   eval->add_option("--lookahead", eval_args->options.decoding.lookahead_codes,
-                   "Codes decoded after the one emitted (latency)");
+                   "Codes decoded after the ones emitted (latency)");
+  eval->add_option("--emit-codes", eval_args->options.decoding.emit_codes,
+                   "Codes whose frames one decoding emits");
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
   eval->add_option("-o,--output", eval_args->output, "Figures as JSON");

@@ -142,6 +142,10 @@ struct StreamDecoding {
   // Codes decoded after the one emitted (latency, 4 frames each): the
   // decoder is least sure at the window's open edge.
   int lookahead_codes = 1;
+  // Codes whose frames one decoding emits: the decoder runs once per this
+  // many codes (its cost shared by their frames) at this many codes' more
+  // latency. They sit just before the lookahead in the window.
+  int emit_codes = 4;
 };
 
 // Where and how a run goes.

@@ -3,12 +3,14 @@
 #include <ATen/CPUGeneratorImpl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace m2d {
 namespace F = torch::nn::functional;
 
-CausalBlockImpl::CausalBlockImpl(int embedding, int num_heads, double dropout) {
+CausalBlockImpl::CausalBlockImpl(int embedding, int num_heads, double dropout)
+    : num_heads_(num_heads) {
   attention_norm_ = register_module(
       "attention_norm",
       torch::nn::LayerNorm(torch::nn::LayerNormOptions({embedding})));
@@ -36,6 +38,43 @@ torch::Tensor CausalBlockImpl::forward(const torch::Tensor& x,
   torch::Tensor y = x + dropout_->forward(attended);
   torch::Tensor m = F::gelu(mlp_in_->forward(mlp_norm_->forward(y)));
   return y + dropout_->forward(mlp_out_->forward(m));
+}
+
+torch::Tensor CausalBlockImpl::Step(const torch::Tensor& x, torch::Tensor* keys,
+                                    torch::Tensor* values) {
+  // Outline: the attention of MultiheadAttention written out on its own
+  // weights (queries of the new tokens against every cached and new key,
+  // causal among the new ones), then the MLP, both pre-LN as forward().
+  const int64_t length = x.size(0);
+  const int64_t embedding = x.size(1);
+  const int64_t head_size = embedding / num_heads_;
+  torch::Tensor h = attention_norm_->forward(x);
+  std::vector<torch::Tensor> qkv =
+      F::linear(h, attention_->in_proj_weight, attention_->in_proj_bias)
+          .chunk(3, -1);
+  auto heads = [&](const torch::Tensor& t) {  // [S, E] -> [H, S, E/H]
+    return t.view({length, num_heads_, head_size}).transpose(0, 1);
+  };
+  const torch::Tensor query = heads(qkv[0]);
+  *keys = keys->defined() ? torch::cat({*keys, heads(qkv[1])}, 1)
+                          : heads(qkv[1]).contiguous();
+  *values = values->defined() ? torch::cat({*values, heads(qkv[2])}, 1)
+                              : heads(qkv[2]).contiguous();
+  torch::Tensor scores = torch::matmul(query, keys->transpose(1, 2)) /
+                         std::sqrt(static_cast<double>(head_size));
+  if (length > 1) {
+    const int64_t total = keys->size(1);
+    scores = scores + torch::full({length, total},
+                                  -std::numeric_limits<float>::infinity())
+                          .triu(total - length + 1);
+  }
+  torch::Tensor attended = torch::matmul(torch::softmax(scores, -1), *values)
+                               .transpose(0, 1)
+                               .reshape({length, embedding});
+  attended = attention_->out_proj->forward(attended);
+  torch::Tensor y = x + attended;
+  torch::Tensor m = F::gelu(mlp_in_->forward(mlp_norm_->forward(y)));
+  return y + mlp_out_->forward(m);
 }
 
 GptImpl::GptImpl(int num_codes, const GptOptions& options)
@@ -82,6 +121,24 @@ torch::Tensor GptImpl::forward(const torch::Tensor& tokens) {
           .triu(1);
   for (CausalBlock& block : blocks_) x = block->forward(x, mask);
   return head_->forward(final_norm_->forward(x.transpose(0, 1)));
+}
+
+torch::Tensor GptImpl::ForwardCached(const torch::Tensor& tokens,
+                                     GptCache* cache) {
+  const int64_t count = tokens.size(0);
+  TORCH_CHECK(cache->length + count <= options_.context_tokens,
+              "cached GPT input of ", cache->length + count,
+              " tokens exceeds the context of ", options_.context_tokens);
+  if (cache->keys.empty()) {
+    cache->keys.resize(blocks_.size());
+    cache->values.resize(blocks_.size());
+  }
+  torch::Tensor x = token_embedding_->forward(tokens) +
+                    position_embedding_.narrow(0, cache->length, count);
+  for (size_t b = 0; b < blocks_.size(); ++b)
+    x = blocks_[b]->Step(x, &cache->keys[b], &cache->values[b]);
+  cache->length += count;
+  return head_->forward(final_norm_->forward(x[count - 1]));
 }
 
 TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
@@ -139,18 +196,30 @@ TokenSampler::TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed)
 }
 
 int64_t TokenSampler::Next() {
-  torch::NoGradGuard no_grad;
+  // Inference only: no autograd bookkeeping on any tensor made here.
+  c10::InferenceMode inference;
   gpt_->eval();
-  const int64_t length = std::min<int64_t>(
-      static_cast<int64_t>(history_.size()), gpt_->context_tokens());
-  torch::Tensor window =
-      torch::tensor(
-          std::vector<int64_t>(history_.end() - length, history_.end()),
-          torch::kLong)
-          .unsqueeze(0);
-  torch::Tensor logits =
-      gpt_->forward(window).select(1, length - 1).squeeze(0) /
-      options_.temperature;
+  // Outline: feed the cache what it has not seen (everything since a
+  // restart, or the last code); draw from the logits; append.
+  const int64_t context = gpt_->context_tokens();
+  torch::Tensor logits;
+  if (cache_.length == 0 || cache_.length == context) {
+    // A restart: the last half of the context (all of a short history).
+    const int64_t keep =
+        std::min<int64_t>(static_cast<int64_t>(history_.size()),
+                          cache_.length == context ? context / 2 : context);
+    cache_ = GptCache();
+    logits = gpt_->ForwardCached(
+        torch::tensor(
+            std::vector<int64_t>(history_.end() - keep, history_.end()),
+            torch::kLong),
+        &cache_);
+  } else {
+    logits = gpt_->ForwardCached(
+        torch::tensor(std::vector<int64_t>{history_.back()}, torch::kLong),
+        &cache_);
+  }
+  logits = logits / options_.temperature;
   if (options_.top_k > 0 && options_.top_k < logits.size(0)) {
     const float threshold =
         std::get<0>(logits.topk(options_.top_k)).min().item<float>();
@@ -162,8 +231,8 @@ int64_t TokenSampler::Next() {
           .item<int64_t>();
   history_.push_back(code);
   // The history only needs the attended window.
-  if (history_.size() > static_cast<size_t>(4 * gpt_->context_tokens()))
-    history_.erase(history_.begin(), history_.end() - gpt_->context_tokens());
+  if (history_.size() > static_cast<size_t>(4 * context))
+    history_.erase(history_.begin(), history_.end() - context);
   codes_.push_back(code);
   return code;
 }

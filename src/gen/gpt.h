@@ -20,14 +20,29 @@ class CausalBlockImpl : public torch::nn::Module {
   CausalBlockImpl(int embedding, int num_heads, double dropout);
   // x: [S, B, E]; mask: [S, S] additive (-inf above the diagonal).
   torch::Tensor forward(const torch::Tensor& x, const torch::Tensor& mask);
+  // Inference on new tokens x [S, E] (one sequence) that follow the ones
+  // whose attention keys and values are in `keys`, `values` ([H, L, E/H],
+  // undefined when L = 0); appends the new tokens' to them. The same
+  // numbers as forward() on the whole sequence, with the mask.
+  torch::Tensor Step(const torch::Tensor& x, torch::Tensor* keys,
+                     torch::Tensor* values);
 
  private:
   torch::nn::LayerNorm attention_norm_{nullptr}, mlp_norm_{nullptr};
   torch::nn::MultiheadAttention attention_{nullptr};
   torch::nn::Linear mlp_in_{nullptr}, mlp_out_{nullptr};
   torch::nn::Dropout dropout_{nullptr};
+  int num_heads_;
 };
 TORCH_MODULE(CausalBlock);
+
+// What incremental inference keeps of the tokens seen so far: per block,
+// their attention keys and values; and how many there are (their positions
+// are 0 .. length - 1).
+struct GptCache {
+  std::vector<torch::Tensor> keys, values;
+  int64_t length = 0;
+};
 
 class GptImpl : public torch::nn::Module {
  public:
@@ -37,6 +52,11 @@ class GptImpl : public torch::nn::Module {
   // tokens: [B, S] int64 in [0, K], S <= context_tokens -> logits over the
   // K codes [B, S, K] for each next token.
   torch::Tensor forward(const torch::Tensor& tokens);
+
+  // Inference: appends `tokens` (a 1-D int64 tensor, at most the context
+  // left in `cache`) to the cached sequence and returns the logits [K] for
+  // the token after them. Matches forward() on the cached sequence.
+  torch::Tensor ForwardCached(const torch::Tensor& tokens, GptCache* cache);
 
   int num_codes() const { return num_codes_; }
   int64_t start_token() const { return num_codes_; }
@@ -89,6 +109,12 @@ class TokenSampler {
   torch::Generator generator_;
   std::vector<int64_t> history_;  // start token, then the codes
   std::vector<int64_t> codes_;
+  // The keys and values of the attended tokens (the tail of history_).
+  // When the context is full, it restarts from its last half: each code
+  // attends to between half the context and all of it, as training windows
+  // that start mid-sequence do, and a code costs one token's pass instead
+  // of the whole context's.
+  GptCache cache_;
 };
 
 }  // namespace m2d

@@ -19,38 +19,48 @@ MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                       ": they come from different runs");
   }
   const StreamDecoding& decoding = options_.decoding;
-  if (decoding.lookahead_codes < 0 ||
-      decoding.context_codes < decoding.lookahead_codes + 1)
+  if (decoding.lookahead_codes < 0 || decoding.emit_codes < 1 ||
+      decoding.context_codes < decoding.lookahead_codes + decoding.emit_codes)
     throw ConfigError(
-        "stream: lookahead_codes must be >= 0 and context_codes > "
-        "lookahead_codes");
+        "stream: lookahead_codes must be >= 0, emit_codes >= 1 and "
+        "context_codes >= lookahead_codes + emit_codes");
   tokenizer_.model->eval();
 }
 
 void MotionStream::Next(std::vector<float>* rows) {
-  torch::NoGradGuard no_grad;
-  // Outline: draw codes until the lookahead after the next code to emit
-  // exists; decode the latest codes; keep the frames of the code to emit.
-  const int64_t end = emitted_codes_ + 1 + options_.decoding.lookahead_codes;
-  while (static_cast<int64_t>(sampler_.codes().size()) < end) sampler_.Next();
-  const std::vector<int64_t>& codes = sampler_.codes();
-  // Codes [begin, end) are decoded.
-  const int64_t begin =
-      std::max<int64_t>(0, end - options_.decoding.context_codes);
-  torch::Tensor window =
-      torch::tensor(
-          std::vector<int64_t>(codes.begin() + begin, codes.begin() + end),
-          torch::kLong)
-          .unsqueeze(0);
-  torch::Tensor frames = tokenizer_.model->Decode(window)[0];  // [T, C]
+  // Inference only: no autograd bookkeeping on any tensor made here.
+  c10::InferenceMode inference;
+  // Outline: when nothing decoded is left, draw codes until the lookahead
+  // after the next emit_codes codes exists, decode the latest codes and
+  // keep the frames of those emit_codes; then emit one code's frames.
   const int per_token = frames_per_token();
-  torch::Tensor emitted =
-      (frames.narrow(0, (emitted_codes_ - begin) * per_token, per_token) *
-           tokenizer_.std +
-       tokenizer_.mean)
-          .contiguous();
-  rows->insert(rows->end(), emitted.data_ptr<float>(),
-               emitted.data_ptr<float>() + emitted.numel());
+  const size_t row_size = static_cast<size_t>(frame_size());
+  if (next_decoded_row_ * row_size >= decoded_.size()) {
+    const StreamDecoding& decoding = options_.decoding;
+    const int64_t end =
+        emitted_codes_ + decoding.emit_codes + decoding.lookahead_codes;
+    while (static_cast<int64_t>(sampler_.codes().size()) < end) sampler_.Next();
+    const std::vector<int64_t>& codes = sampler_.codes();
+    // Codes [begin, end) are decoded.
+    const int64_t begin = std::max<int64_t>(0, end - decoding.context_codes);
+    torch::Tensor window =
+        torch::tensor(
+            std::vector<int64_t>(codes.begin() + begin, codes.begin() + end),
+            torch::kLong)
+            .unsqueeze(0);
+    torch::Tensor frames = tokenizer_.model->Decode(window)[0];  // [T, C]
+    torch::Tensor kept = (frames.narrow(0, (emitted_codes_ - begin) * per_token,
+                                        decoding.emit_codes * per_token) *
+                              tokenizer_.std +
+                          tokenizer_.mean)
+                             .contiguous();
+    decoded_.assign(kept.data_ptr<float>(),
+                    kept.data_ptr<float>() + kept.numel());
+    next_decoded_row_ = 0;
+  }
+  const auto first = decoded_.begin() + next_decoded_row_ * row_size;
+  rows->insert(rows->end(), first, first + per_token * row_size);
+  next_decoded_row_ += per_token;
   ++emitted_codes_;
 }
 

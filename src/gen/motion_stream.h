@@ -18,9 +18,10 @@ struct MotionStreamOptions {
   uint64_t seed = 1;
 };
 
-// Each Next() emits one code's frames. The frames of a code are decoded
-// once `decoding.lookahead_codes` codes after it exist, so that the decoder
-// does not work at the window's open edge.
+// Each Next() emits one code's frames. Frames are decoded for
+// `decoding.emit_codes` codes at a time, once `decoding.lookahead_codes`
+// codes after them exist, so that the decoder does not work at the
+// window's open edge; later calls emit the frames already decoded.
 class MotionStream {
  public:
   MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
@@ -39,6 +40,8 @@ class MotionStream {
   TokenSampler sampler_;
   MotionStreamOptions options_;
   int64_t emitted_codes_ = 0;
+  std::vector<float> decoded_;   // frames decoded, not yet emitted
+  size_t next_decoded_row_ = 0;  // in decoded_, in rows
 };
 
 }  // namespace m2d

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <memory>
 
+#include "common/error.h"
 #include "common/file_io.h"
 #include "gen/gen_checkpoint.h"
 #include "gen/gen_test_data.h"
@@ -90,7 +91,27 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
   for (int i = 0; i < 20; ++i) stream.Next(&rows);  // past the context
   EXPECT_EQ(rows.size(), 20u * 4 * 37);
   for (float value : rows) ASSERT_TRUE(std::isfinite(value));
+  // Decoding 4 codes at a time (the default) draws up to 4 + the
+  // lookahead codes ahead of the frames emitted.
   EXPECT_GE(stream.codes().size(), 21u);
+  EXPECT_LE(stream.codes().size(), 25u);
+
+  // A decoding per code emits the same number of frames from the same
+  // codes (the sampler does not depend on how frames are decoded).
+  options.decoding.emit_codes = 1;
+  MotionStream per_code(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                        LoadPrior(config.run.run_dir + "/prior.pt"), options);
+  std::vector<float> per_code_rows;
+  for (int i = 0; i < 20; ++i) per_code.Next(&per_code_rows);
+  EXPECT_EQ(per_code_rows.size(), rows.size());
+  for (size_t i = 0; i < per_code.codes().size(); ++i)
+    EXPECT_EQ(per_code.codes()[i], stream.codes()[i]);
+  // Settings it cannot keep.
+  options.decoding.emit_codes = 16;
+  EXPECT_THROW(
+      MotionStream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                   LoadPrior(config.run.run_dir + "/prior.pt"), options),
+      ConfigError);
 }
 
 TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {

@@ -30,6 +30,28 @@ TEST(Gpt, IsCausal) {
   EXPECT_FALSE(torch::allclose(a.narrow(1, 4, 2), b.narrow(1, 4, 2)));
 }
 
+TEST(Gpt, CachedInferenceMatchesTheFullForward) {
+  // A prefix at once, then token by token: every step's logits equal the
+  // full forward's at that position.
+  torch::manual_seed(3);
+  Gpt gpt(16, SmallGpt());
+  gpt->eval();
+  torch::NoGradGuard no_grad;
+  const torch::Tensor tokens =
+      torch::tensor({16, 3, 5, 7, 9, 11, 2, 2, 14, 0, 1, 6}, torch::kLong);
+  const torch::Tensor full = gpt->forward(tokens.unsqueeze(0))[0];  // [S, K]
+  GptCache cache;
+  torch::Tensor logits = gpt->ForwardCached(tokens.narrow(0, 0, 4), &cache);
+  EXPECT_TRUE(torch::allclose(logits, full[3], 1e-5, 1e-5));
+  for (int64_t s = 4; s < tokens.size(0); ++s) {
+    logits = gpt->ForwardCached(tokens.narrow(0, s, 1), &cache);
+    EXPECT_TRUE(torch::allclose(logits, full[s], 1e-5, 1e-5)) << "at " << s;
+  }
+  EXPECT_EQ(cache.length, 12);
+  // The context is full: one more token is refused.
+  EXPECT_THROW(gpt->ForwardCached(tokens.narrow(0, 0, 1), &cache), c10::Error);
+}
+
 TEST(Gpt, SamplingIsDeterministicForASeed) {
   torch::manual_seed(1);
   Gpt gpt(16, SmallGpt());
