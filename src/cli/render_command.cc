@@ -72,6 +72,11 @@ void AddRenderCommand(CLI::App& app, CommandRun* run) {
                      "MP4 file to write");
   render->add_option("--png-dir", args->replay.output.png_folder,
                      "Also write every frame as frame_<n>.png here");
+  render->add_flag_function(
+      "--estimate",
+      [args](int64_t) { args->replay.motion = ReplayedMotion::kEstimate; },
+      "Replay the fit's estimate (its cameras and poses, mimic2d fit) "
+      "instead of the ground truth: how well the fit explains the 2D");
   render->add_option("--view", args->replay.view,
                      "View (camera) name; default: the first view");
   render

@@ -438,10 +438,25 @@ bool SourceVideoFrames::Next(EpisodeFrame* frame) {
 BundleReplaySource::BundleReplaySource(
     const ReferenceBundle& bundle, int view_index,
     std::shared_ptr<const Character> character,
-    const SimulationOptions& simulation)
+    const SimulationOptions& simulation, ReplayedMotion motion)
     : bundle_(bundle),
       view_(bundle.views.at(view_index)),
       simulation_(character, simulation) {
+  if (motion == ReplayedMotion::kEstimate) {
+    if (!bundle.estimate) {
+      throw InputError(bundle.name,
+                       "has no estimate to replay: fit it first (mimic2d fit)");
+    }
+    estimate_ = &(*bundle.estimate)[view_index];
+    if (estimate_->skeleton_name != character->skeleton().name) {
+      throw InputError(bundle.name, "the estimate of view " + view_.name +
+                                        " is of skeleton '" +
+                                        estimate_->skeleton_name +
+                                        "', not the character's");
+    }
+    shows_character_ = true;
+    return;
+  }
   if (view_.cameras.empty()) {
     throw InputError(bundle.name, "view " + view_.name +
                                       " has no true cameras (stripped): "
@@ -457,14 +472,16 @@ bool BundleReplaySource::Next(EpisodeFrame* frame) {
   if (t >= bundle_.num_frames()) return false;
   ++next_frame_;
   frame->clip_frame = t;
-  frame->camera = view_.CameraAt(t);
+  frame->camera =
+      estimate_ != nullptr ? estimate_->CameraAt(t) : view_.CameraAt(t);
   const Clip2D& clip = view_.clip;
   frame->reference.assign(
       clip.keypoints.frame(t),
       clip.keypoints.frame(t) + clip.keypoints.num_keypoints());
   frame->keypoints_world_m.clear();
   if (shows_character_) {
-    simulation_.SetPose(bundle_.ground_truth->poses[t]);
+    simulation_.SetPose(estimate_ != nullptr ? estimate_->poses[t]
+                                             : bundle_.ground_truth->poses[t]);
     if (!frame->state) frame->state.emplace();
     simulation_.Save(&*frame->state);
   } else {
@@ -499,9 +516,14 @@ EpisodeSummary RenderBundleReplay(const ReferenceBundle& bundle,
   const SimulationOptions simulation;
   std::shared_ptr<const Character> character = LoadCharacterForSimulation(
       options.character_config, options.scene, simulation);
-  BundleReplaySource replay(bundle, view_index, character, simulation);
+  BundleReplaySource replay(bundle, view_index, character, simulation,
+                            options.motion);
   EpisodeRenderOptions render = options.render;
-  if (!replay.shows_character()) render.pose_label = "3D ground truth";
+  if (options.motion == ReplayedMotion::kEstimate) {
+    render.pose_label = "fitted pose";
+  } else if (!replay.shows_character()) {
+    render.pose_label = "3D ground truth";
+  }
   const Clip2D& clip = bundle.views[view_index].clip;
   return RenderViewFrames(replay, character, simulation, clip, bundle.fps,
                           render, options);

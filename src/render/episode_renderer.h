@@ -188,21 +188,29 @@ struct EpisodeSummary {
 EpisodeSummary RenderEpisode(FrameSource& source, EpisodeRenderer& renderer,
                              const EpisodeOutputOptions& output);
 
-// Kinematic replay of a bundle view: each frame puts the character in the
-// ground-truth pose when the bundle's poses belong to the character's
-// skeleton; otherwise the scene is drawn without the character and the
-// ground-truth 3D keypoints (if any) are projected instead.
+// What a replay shows: the bundle's ground truth (true cameras and poses),
+// or the view's fit (`mimic2d fit`'s estimated cameras and poses: how well
+// the fit explains the 2D).
+enum class ReplayedMotion { kTruth, kEstimate };
+
+// Kinematic replay of a bundle view. From the truth: each frame puts the
+// character in the ground-truth pose when the bundle's poses belong to the
+// character's skeleton; otherwise the scene is drawn without the character
+// and the ground-truth 3D keypoints (if any) are projected instead. From the
+// estimate: the fitted pose under the fitted camera.
 class BundleReplaySource : public FrameSource {
  public:
   BundleReplaySource(const ReferenceBundle& bundle, int view_index,
                      std::shared_ptr<const Character> character,
-                     const SimulationOptions& simulation);
+                     const SimulationOptions& simulation,
+                     ReplayedMotion motion = ReplayedMotion::kTruth);
   bool Next(EpisodeFrame* frame) override;
   bool shows_character() const { return shows_character_; }
 
  private:
   const ReferenceBundle& bundle_;
   const ReferenceView& view_;
+  const ViewEstimate* estimate_ = nullptr;  // replaying the fit
   Simulation simulation_;
   bool shows_character_ = false;
   int next_frame_ = 0;
@@ -212,6 +220,7 @@ struct BundleReplayOptions {
   std::string character_config;  // e.g. assets/characters/humanoid.yaml
   std::string scene = "flat";
   std::string view;  // view name; empty: the first view
+  ReplayedMotion motion = ReplayedMotion::kTruth;
   // The recording the view's 2D came from, shown beside the render
   // (SourceVideoFrames); empty: none. `source_video_start_s`: the time in
   // it of the clip's frame 0.

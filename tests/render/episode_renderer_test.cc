@@ -286,6 +286,48 @@ TEST(BundleReplay, SkeletonWithoutCharacterShowsTheGroundTruth) {
   EXPECT_EQ(testing::ProbeVideo(summary.video_path).frames, 5);
 }
 
+// A fitted bundle replays its estimate: the fitted pose under the fitted
+// camera, with no truth left. The estimate here is the truth moved into
+// it (a perfect fit), shifted by 0.1 m in depth on frame 2 to show that the
+// estimate, not something else, is drawn.
+TEST(BundleReplay, AFittedBundleReplaysItsEstimate) {
+  M2D_REQUIRE_SHARED(motion_path, kWalk);
+  auto character = testing::LoadRenderHumanoid();
+  ReferenceBundle bundle =
+      testing::MakeWalkBundle(motion_path, *character, 0.5);
+  BundleReplayOptions options;
+  options.character_config =
+      testing::SourcePath("assets/characters/humanoid.yaml");
+  options.motion = ReplayedMotion::kEstimate;
+  options.render.scale = 0.25;
+  options.output.video_path = testing::TempDir("estimate_replay") + "/fit.mp4";
+  options.output.last_frame = 4;
+  // Not fitted yet: a named error.
+  EXPECT_THROW(RenderBundleReplay(bundle, options), InputError);
+
+  std::vector<ViewEstimate> estimates;
+  for (const ReferenceView& view : bundle.views) {
+    ViewEstimate estimate;
+    estimate.cameras = view.cameras;
+    estimate.skeleton_name = bundle.ground_truth->skeleton_name;
+    estimate.poses = bundle.ground_truth->poses;
+    estimate.residual_px.assign(bundle.num_frames(), 0.0);
+    estimates.push_back(estimate);
+  }
+  estimates[0].poses[2].root_position_m.x() += 0.1;
+  bundle.estimate = estimates;
+  bundle.ground_truth.reset();
+  for (ReferenceView& view : bundle.views) view.cameras.clear();  // stripped
+  const EpisodeSummary summary = RenderBundleReplay(bundle, options);
+  EXPECT_EQ(summary.frames_rendered, 5);
+  // Four frames exact, one off by the shift.
+  EXPECT_GT(summary.mean_e2d_px, 0.1);
+  EXPECT_LT(summary.mean_e2d_px, 10.0);
+  estimates[0].poses[2].root_position_m.x() -= 0.1;
+  bundle.estimate = estimates;
+  EXPECT_LT(RenderBundleReplay(bundle, options).mean_e2d_px, 1e-6);
+}
+
 TEST(SourceVideoFrames, AClipFrameShowsTheVideoFrameOfItsMoment) {
   // A 10 fps video whose frame k is grey level 20 k, and a 30 Hz clip of
   // 13 frames starting 0.1 s into it: clip frame t is at 0.1 + t / 30 s,
