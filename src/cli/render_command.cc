@@ -33,11 +33,18 @@ int RunRender(RenderArgs& args) {
   if (!args.starts.empty())
     sources.initial_states = ParseInitialStateSource(args.starts);
   if (!args.cameras.empty()) sources.cameras = ParseCameraSource(args.cameras);
-  const EpisodeSummary summary =
-      args.policy.empty()
-          ? RenderBundleReplay(bundle, args.replay)
-          : RenderCheckpointRollout(args.policy, bundle, args.replay,
-                                    args.start_frame, args.episode_s, sources);
+  EpisodeSummary summary;
+  try {
+    summary = args.policy.empty()
+                  ? RenderBundleReplay(bundle, args.replay)
+                  : RenderCheckpointRollout(args.policy, bundle, args.replay,
+                                            args.start_frame, args.episode_s,
+                                            sources);
+  } catch (const InputError& e) {
+    // The library names the bundle; the user needs the file.
+    if (e.source() != bundle.name) throw;
+    throw InputError(args.bundle + " (" + bundle.name + ")", e.problem());
+  }
   std::cout << "rendered " << summary.frames_rendered << " frames, "
             << summary.width_px << "x" << summary.height_px << " px";
   if (std::isfinite(summary.mean_e2d_px)) {

@@ -145,6 +145,12 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
       << info.output;
   ExpectInputError("clip strip " + dir + "/absent.json -o " + dir + "/x.json",
                    dir + "/absent.json", "cannot open");
+  // A stripped bundle has nothing to replay: no truth, no fit yet.
+  ExpectInputError("render " + stripped_path + " -o " + dir + "/x.mp4",
+                   stripped_path, "no true cameras");
+  ExpectInputError(
+      "render " + stripped_path + " --estimate -o " + dir + "/x.mp4",
+      stripped_path, "has no estimate to replay");
 
   // Eval of the committed walk policy from the estimate alone, measured
   // against the truth kept in the original file.
