@@ -19,13 +19,6 @@
 
 namespace m2d {
 
-// The value of a number or of a Jet, without its derivatives.
-inline double ScalarPart(double x) { return x; }
-template <typename T, int N>
-double ScalarPart(const ceres::Jet<T, N>& x) {
-  return x.a;
-}
-
 // Per-coordinate Geman-McClure as a residual: its square is SMPLify's GMoF
 // sigma^2 x^2 / (sigma^2 + x^2); smooth, ~x near 0, bounded by sigma.
 template <typename T>
@@ -138,20 +131,7 @@ struct LimbCost {
       *out = T(0);
       return true;
     }
-    // The best component at the current angles, held for the derivative.
-    double angles[kMaxHinges];
-    for (int i = 0; i < num_limb_hinges; ++i)
-      angles[i] = ScalarPart(blocks[0][i]);
-    const int k = limb_mixture->BestComponent(angles);
-    const Eigen::MatrixXd& factor = limb_mixture->precision_factors[k];
-    for (int r = 0; r < num_limb_hinges; ++r, ++out) {
-      T sum(0);
-      for (int c = r; c < num_limb_hinges; ++c)
-        sum += factor(r, c) * (blocks[0][c] - T(limb_mixture->means[k][c]));
-      *out = T(mixture_weight) * sum;
-    }
-    *out =
-        T(mixture_weight * std::sqrt(2.0 * limb_mixture->component_costs[k]));
+    MixtureResiduals(*limb_mixture, mixture_weight, blocks[0], out);
     return true;
   }
 

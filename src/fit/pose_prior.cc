@@ -225,16 +225,10 @@ MixturePriorCost::MixturePriorCost(const PoseMixture* mixture, double weight)
 bool MixturePriorCost::Evaluate(double const* const* parameters,
                                 double* residuals, double** jacobians) const {
   const int dims = mixture_->num_hinges();
-  const int k = mixture_->BestComponent(parameters[0]);
-  const Eigen::Map<const Eigen::VectorXd> angles(parameters[0], dims);
-  const Eigen::MatrixXd& factor = mixture_->precision_factors[k];
-  Eigen::Map<Eigen::VectorXd> out(residuals, dims + 1);
-  const Eigen::VectorXd offset = angles - mixture_->means[k];
-  const Eigen::VectorXd whitened =
-      factor.triangularView<Eigen::Upper>() * offset;
-  out.head(dims) = weight_ * whitened;
-  out[dims] = weight_ * std::sqrt(2.0 * mixture_->component_costs[k]);
+  MixtureResiduals(*mixture_, weight_, parameters[0], residuals);
   if (jacobians != nullptr && jacobians[0] != nullptr) {
+    const Eigen::MatrixXd& factor =
+        mixture_->precision_factors[mixture_->BestComponent(parameters[0])];
     Eigen::Map<
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
         jacobian(jacobians[0], dims + 1, dims);

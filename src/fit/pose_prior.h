@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,33 @@ void WritePoseMixtureAtomic(const PoseMixture& mixture,
 void CheckPoseMixtureHinges(const PoseMixture& mixture,
                             const std::vector<std::string>& hinge_names,
                             const std::string& source);
+
+// The value of a number or of a Jet, without its derivatives.
+inline double ScalarPart(double x) { return x; }
+template <typename T, int N>
+double ScalarPart(const ceres::Jet<T, N>& x) {
+  return x.a;
+}
+
+// The prior's num_hinges() + 1 residuals at `angles` (doubles or Jets):
+// weight x [U_k (a - mu_k); sqrt(2 c_k)], k the best component at the
+// angles' values (held for the derivatives).
+template <typename T>
+void MixtureResiduals(const PoseMixture& mixture, double weight,
+                      const T* angles, T* residuals) {
+  const int dims = mixture.num_hinges();
+  std::vector<double> values(dims);
+  for (int i = 0; i < dims; ++i) values[i] = ScalarPart(angles[i]);
+  const int k = mixture.BestComponent(values.data());
+  const Eigen::MatrixXd& factor = mixture.precision_factors[k];
+  for (int r = 0; r < dims; ++r) {
+    T sum(0);
+    for (int c = r; c < dims; ++c)
+      sum += factor(r, c) * (angles[c] - T(mixture.means[k][c]));
+    residuals[r] = T(weight) * sum;
+  }
+  residuals[dims] = T(weight * std::sqrt(2.0 * mixture.component_costs[k]));
+}
 
 // The fit's pose-prior term on one block of hinge angles (`mixture`'s
 // dimensions): weight x [U_k (a - mu_k); sqrt(2 c_k)] for the best component
