@@ -32,6 +32,9 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run);
 
 // Where assets/ lives: $MIMIC2D_ASSETS, else the source tree's assets/.
 std::string AssetPath(const std::string& relative);
+// A path given on the command line for an asset: as is when absolute, else
+// relative to assets/ (e.g. --character characters/humanoid.yaml).
+std::string AssetArgumentPath(const std::string& argument);
 
 }  // namespace m2d::cli
 

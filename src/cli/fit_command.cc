@@ -55,9 +55,7 @@ int RunFit(FitArgs& args) {
   }
   args.options.Validate();
   const ReferenceBundle bundle = ReadBundleOrClip(args.input);
-  const std::string character_path = args.character.find('/') == 0
-                                         ? args.character
-                                         : AssetPath(args.character);
+  const std::string character_path = AssetArgumentPath(args.character);
   auto character =
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
   std::printf("fitting %zu view(s) of %s (%d frames), camera %s, focal %s\n",

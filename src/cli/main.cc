@@ -20,6 +20,11 @@ std::string AssetPath(const std::string& relative) {
   return base + "/" + relative;
 }
 
+std::string AssetArgumentPath(const std::string& argument) {
+  return !argument.empty() && argument[0] == '/' ? argument
+                                                 : AssetPath(argument);
+}
+
 }  // namespace m2d::cli
 
 int main(int argc, char** argv) {

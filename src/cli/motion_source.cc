@@ -95,7 +95,7 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
     if (!(args.bvh_scale_m > 0)) {
       throw ConfigError("--bvh-scale must be positive");
     }
-    loaded.motion = ReadBvhMotion(args.path, args.bvh_scale_m);
+    loaded.motion = ReadBvhMotion(args.path, args.bvh_scale_m, args.fps);
     std::string map_path = args.keypoint_map.empty()
                                ? AssetPath("skeletons/cmu_bvh.coco17.yaml")
                                : args.keypoint_map;
@@ -106,7 +106,7 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
                                   ? AssetPath("skeletons/humanoid.yaml")
                                   : args.skeleton;
   auto skeleton = std::make_shared<const Skeleton>(LoadSkeleton(skeleton_path));
-  loaded.motion = ReadDeepMimicMotion(args.path, skeleton);
+  loaded.motion = ReadDeepMimicMotion(args.path, skeleton, args.fps);
   std::string map_path = args.keypoint_map.empty()
                              ? AssetPath("skeletons/humanoid.coco17.yaml")
                              : args.keypoint_map;

@@ -16,6 +16,7 @@ struct MotionSourceArgs {
   std::string skeleton;           // DeepMimic: skeleton YAML
   std::string keypoint_map;       // keypoint map YAML
   double bvh_scale_m = 0.056444;  // metres per BVH unit (CMU/cgspeed)
+  double fps = 0.0;               // resampled to this rate; <= 0: the file's
 };
 
 struct LoadedMotion {

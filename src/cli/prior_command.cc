@@ -3,9 +3,9 @@
 // on the character's skeleton (docs/fit.md, "Pose prior").
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 
 #include "cli/commands.h"
+#include "cli/motion_source.h"
 #include "common/error.h"
 #include "fit/pose_prior_training.h"
 #include "fit/retarget.h"
@@ -25,27 +25,29 @@ struct PriorArgs {
 
 int RunPrior(PriorArgs& args) {
   args.options.Validate();
-  const std::string character_path = args.character.find('/') == 0
-                                         ? args.character
-                                         : AssetPath(args.character);
+  const std::string character_path = AssetArgumentPath(args.character);
   auto character =
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
   const auto started = std::chrono::steady_clock::now();
   std::vector<Eigen::VectorXd> samples;
   std::vector<std::string> sources;
   for (const std::string& path : args.motions) {
+    MotionSourceArgs source;
+    source.path = path;
+    source.skeleton = character->config().skeleton_path;
+    source.bvh_scale_m = args.bvh_scale_m;
+    source.fps = 30.0;
+    const LoadedMotion loaded = LoadMotionSource(source);
     std::vector<Eigen::VectorXd> poses;
-    const std::string extension =
-        std::filesystem::path(path).extension().string();
-    if (extension == ".bvh" || extension == ".BVH") {
-      // Another skeleton: its COCO-17 points, fitted by the character.
-      const Motion3D motion = ReadBvhMotion(path, args.bvh_scale_m, 30.0);
-      const KeypointMap map = LoadKeypointMap(
-          AssetPath("skeletons/cmu_bvh.coco17.yaml"), *motion.skeleton);
+    if (loaded.motion.skeleton->name != character->skeleton().name) {
+      // Another skeleton (a BVH capture): its COCO-17 points, fitted by the
+      // character.
       std::vector<std::vector<Eigen::Vector3d>> points;
-      for (int t = 0; t < motion.num_frames(); t += args.options.frame_stride) {
-        points.push_back(
-            KeypointPositions(*motion.skeleton, map, motion.frames[t]));
+      for (int t = 0; t < loaded.motion.num_frames();
+           t += args.options.frame_stride) {
+        points.push_back(KeypointPositions(*loaded.motion.skeleton,
+                                           loaded.keypoint_map,
+                                           loaded.motion.frames[t]));
       }
       RetargetSummary retargeted;
       poses = RetargetKeypointsToHinges(*character, points, RetargetOptions(),
@@ -53,16 +55,14 @@ int RunPrior(PriorArgs& args) {
       std::printf(
           "%s: %zu poses retargeted (%.1f s at 30 Hz, one frame in %d; "
           "scale %.3f, keypoints %.1f cm off on average, %.1f at worst)\n",
-          path.c_str(), poses.size(), motion.duration_s(),
+          path.c_str(), poses.size(), loaded.motion.duration_s(),
           args.options.frame_stride, retargeted.scale,
           100 * retargeted.mean_error_m, 100 * retargeted.worst_frame_error_m);
     } else {
-      const Motion3D motion =
-          ReadDeepMimicMotion(path, character->shared_skeleton(), 30.0);
-      poses = HingeAnglesOfMotion(*character, motion, args.options.frame_stride,
-                                  path);
+      poses = HingeAnglesOfMotion(*character, loaded.motion,
+                                  args.options.frame_stride, path);
       std::printf("%s: %zu poses (%.1f s at 30 Hz, one frame in %d)\n",
-                  path.c_str(), poses.size(), motion.duration_s(),
+                  path.c_str(), poses.size(), loaded.motion.duration_s(),
                   args.options.frame_stride);
     }
     samples.insert(samples.end(), poses.begin(), poses.end());

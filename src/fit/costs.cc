@@ -94,6 +94,15 @@ std::vector<int32_t> SlideBlockSizes(const KinematicModel& model) {
           kRootPositionSize, kRootQuaternionSize, hinges};
 }
 
+std::vector<int32_t> BalanceBlockSizes(const KinematicModel& model) {
+  std::vector<int32_t> sizes;
+  for (int frame = 0; frame < 3; ++frame) {
+    sizes.insert(sizes.end(),
+                 {kRootPositionSize, kRootQuaternionSize, model.num_hinges()});
+  }
+  return sizes;
+}
+
 }  // namespace
 
 bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
@@ -233,6 +242,95 @@ ceres::CostFunction* FootSlideCost::Create(FootSlideCost cost) {
   const int num_residuals = 2 * cost.model->num_sole_points();
   return new AnalyticCostFunction<FootSlideCost>(std::move(cost), sizes,
                                                  num_residuals);
+}
+
+bool BalanceCost::Evaluate(double const* const* blocks, double* residuals,
+                           double** jacobians) const {
+  // Outline: the three frames' centres of mass with their Jacobians; the
+  // zero-moment point as 9-wide Jets in those centres; frame t's support
+  // box; per axis the distance outside it, chained into the pose blocks
+  // (through the centres, and through the sole point that bounds the box).
+  using Jet9 = ceres::Jet<double, 9>;
+  constexpr double kGravity_m_s2 = 9.81;
+  const int num_hinges = model->num_hinges();
+  const int columns = PoseJacobianColumns(*model);
+  ZeroJacobians(jacobians, BalanceBlockSizes(*model), 2);
+  double com[3][3];
+  std::vector<double> com_jacobian[3];
+  for (int f = 0; f < 3; ++f) {
+    com_jacobian[f].resize(3 * columns);
+    CenterOfMassWithJacobian(*model, blocks[3 * f], blocks[3 * f + 1],
+                             blocks[3 * f + 2], com[f], com_jacobian[f].data());
+  }
+  Jet9 c[3][3];
+  for (int f = 0; f < 3; ++f)
+    for (int k = 0; k < 3; ++k) c[f][k] = Jet9(com[f][k], 3 * f + k);
+  const double inv_span2 = 1.0 / (span_s * span_s);
+  Jet9 acceleration[3];
+  for (int k = 0; k < 3; ++k)
+    acceleration[k] = (c[0][k] - 2.0 * c[1][k] + c[2][k]) * inv_span2;
+  // A body falling faster than 0.8 g has no support to balance on; the
+  // floor keeps the division finite.
+  Jet9 vertical = acceleration[2] + kGravity_m_s2;
+  if (vertical.a < 0.2 * kGravity_m_s2) vertical = Jet9(0.2 * kGravity_m_s2);
+  const Jet9 zmp[2] = {c[1][0] - c[1][2] * acceleration[0] / vertical,
+                       c[1][1] - c[1][2] * acceleration[1] / vertical};
+
+  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5]);
+  const int first_sole = model->num_keypoints();
+  for (int k = 0; k < 2; ++k) {
+    // The support box along this axis: its in-contact sole points' extent.
+    int low = -1, high = -1;
+    for (int s = 0; s < model->num_sole_points(); ++s) {
+      if (!in_contact[s]) continue;
+      const double x = posed.points[3 * (first_sole + s) + k];
+      if (low < 0 || x < posed.points[3 * (first_sole + low) + k]) low = s;
+      if (high < 0 || x > posed.points[3 * (first_sole + high) + k]) high = s;
+    }
+    residuals[k] = 0.0;
+    if (low < 0) continue;
+    const double low_m = posed.points[3 * (first_sole + low) + k] - margin_m;
+    const double high_m = posed.points[3 * (first_sole + high) + k] + margin_m;
+    int bound = -1;
+    if (zmp[k].a < low_m) {
+      residuals[k] = weight * (zmp[k].a - low_m);
+      bound = low;
+    } else if (zmp[k].a > high_m) {
+      residuals[k] = weight * (zmp[k].a - high_m);
+      bound = high;
+    }
+    if (jacobians == nullptr || bound < 0) continue;
+    // Through the centres of mass: d zmp / d c[f] times c[f]'s rows.
+    for (int f = 0; f < 3; ++f) {
+      for (int part = 0; part < 3; ++part) {
+        double* jacobian = jacobians[3 * f + part];
+        if (jacobian == nullptr) continue;
+        const int start = part == 0   ? 0
+                          : part == 1 ? kRootPositionSize
+                                      : kRootPositionSize + kRootQuaternionSize;
+        const int size = part == 0   ? kRootPositionSize
+                         : part == 1 ? kRootQuaternionSize
+                                     : num_hinges;
+        double* row = jacobian + k * size;
+        for (int i = 0; i < 3; ++i) {
+          const double factor = weight * zmp[k].v[3 * f + i];
+          if (factor == 0.0) continue;
+          const double* source = com_jacobian[f].data() + i * columns + start;
+          for (int col = 0; col < size; ++col) row[col] += factor * source[col];
+        }
+      }
+    }
+    // Through the bounding sole point of frame t.
+    const double axis[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, 0.0};
+    posed.AddPoseRow(first_sole + bound, axis, k, -weight, jacobians + 3,
+                     num_hinges);
+  }
+  return true;
+}
+
+ceres::CostFunction* BalanceCost::Create(BalanceCost cost) {
+  const std::vector<int32_t> sizes = BalanceBlockSizes(*cost.model);
+  return new AnalyticCostFunction<BalanceCost>(std::move(cost), sizes, 2);
 }
 
 }  // namespace m2d

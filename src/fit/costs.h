@@ -161,6 +161,29 @@ struct FootSlideCost {
   static ceres::CostFunction* Create(FootSlideCost cost);
 };
 
+// Balance (blocks: the root position, quaternion and hinges of frames
+// t - k, t and t + k): the zero-moment point of frame t, from the centre of
+// mass c and its acceleration a = (c[t-k] - 2 c[t] + c[t+k]) / (k dt)^2
+// (the cart-table model, angular momentum left out),
+//   zmp = c_xy - c_z a_xy / (g + a_z),
+// must lie within the support: the horizontal box of frame t's in-contact
+// sole points, grown by `margin_m`. Residuals, 2: weight x how far the zmp
+// lies outside the box along x and y (0 inside). Gravity is the one
+// direction 2D does not show; a body leaning with nothing under it is how a
+// wrong camera pitch or roll hides, and this is what rules it out.
+struct BalanceCost {
+  const KinematicModel* model;
+  std::vector<bool> in_contact;  // per sole point, at frame t
+  double span_s = 0.1;           // k dt
+  double margin_m = 0.05;
+  double weight = 0.0;
+
+  bool Evaluate(double const* const* blocks, double* residuals,
+                double** jacobians) const;
+
+  static ceres::CostFunction* Create(BalanceCost cost);
+};
+
 // weight x (value - prior), element-wise over one block (pose prior: hinge
 // angles toward the rest pose's 0).
 struct PriorCost {

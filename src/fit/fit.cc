@@ -242,20 +242,26 @@ RestPose MakeRestPose(const KinematicModel& model,
 
 // A start: the rest pose standing on the ray through each frame's 2D root,
 // at the depth where its size matches the 2D size, turned to `yaw_rad`; the
-// camera level, at the height that puts the roots at standing height.
+// camera pitched down by `pitch_rad`, without roll, at the height that puts
+// the roots at standing height.
 Parameters InitialParameters(const Observations& obs,
                              const KinematicModel& model, const RestPose& rest,
                              const FitOptions& options, double focal_px,
-                             double yaw_rad) {
+                             double yaw_rad, double pitch_rad) {
   Parameters params;
   params.focal_px = focal_px;
+  params.pitch_roll_rad[0] = pitch_rad;
+  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
   const double cx = 0.5 * obs.width_px, cy = 0.5 * obs.height_px;
-  std::vector<double> depth_m(obs.num_frames);
+  // Each root relative to the camera centre, in the world's axes.
+  std::vector<Eigen::Vector3d> from_camera_m(obs.num_frames);
   std::vector<double> drop_m;  // how far below the camera each root is
   for (int t = 0; t < obs.num_frames; ++t) {
-    depth_m[t] = focal_px * rest.scale_m / obs.scale_px[t];
-    if (obs.usable[t])
-      drop_m.push_back(depth_m[t] * (obs.root_px[t].y() - cy) / focal_px);
+    const double depth_m = focal_px * rest.scale_m / obs.scale_px[t];
+    const Eigen::Vector3d ray_camera((obs.root_px[t].x() - cx) / focal_px,
+                                     (obs.root_px[t].y() - cy) / focal_px, 1.0);
+    from_camera_m[t] = rotation.transpose() * (depth_m * ray_camera);
+    if (obs.usable[t]) drop_m.push_back(-from_camera_m[t].z());
   }
   const double root_height_m =
       model.standing_root_height_m + rest.root_keypoint_offset_m.z();
@@ -263,15 +269,11 @@ Parameters InitialParameters(const Observations& obs,
   const int num_centres =
       options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1;
   params.centres_m.assign(num_centres, Eigen::Vector3d(0, 0, height_m));
-  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
   const Eigen::Quaterniond turn(
       Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()));
   for (int t = 0; t < obs.num_frames; ++t) {
-    const Eigen::Vector3d ray_camera((obs.root_px[t].x() - cx) / focal_px,
-                                     (obs.root_px[t].y() - cy) / focal_px, 1.0);
     const Eigen::Vector3d root_keypoints =
-        Eigen::Vector3d(params.centre(t)) +
-        rotation.transpose() * (depth_m[t] * ray_camera);
+        Eigen::Vector3d(params.centre(t)) + from_camera_m[t];
     params.root_m.push_back(root_keypoints -
                             turn * rest.root_keypoint_offset_m);
     params.quaternion_wxyz.emplace_back(turn.w(), turn.x(), turn.y(), turn.z());
@@ -588,6 +590,33 @@ void BuildProblem(Stage stage, const Observations& obs,
            params.hinges_rad[t].data(), params.root_m[t + 1].data(),
            params.quaternion_wxyz[t + 1].data(),
            params.hinges_rad[t + 1].data()});
+    }
+  }
+  // The zero-moment point over the support, where a sole is in contact.
+  if (stage == Stage::kPoseWithContacts && contacts != nullptr &&
+      options.balance_weight > 0) {
+    const int span = std::max(
+        1, static_cast<int>(std::lround(options.balance_span_s * obs.fps)));
+    for (int t = span; t + span < num_frames; ++t) {
+      BalanceCost cost;
+      cost.model = &model;
+      cost.span_s = span / obs.fps;
+      cost.margin_m = options.balance_margin_m;
+      cost.weight = options.balance_weight;
+      bool any = false;
+      for (int s = 0; s < model.num_sole_points(); ++s) {
+        cost.in_contact.push_back((*contacts)[t][s] >= 0.5);
+        any = any || cost.in_contact.back();
+      }
+      if (!any) continue;
+      std::vector<double*> blocks;
+      for (int f : {t - span, t, t + span}) {
+        blocks.insert(blocks.end(), {params.root_m[f].data(),
+                                     params.quaternion_wxyz[f].data(),
+                                     params.hinges_rad[f].data()});
+      }
+      problem.AddResidualBlock(BalanceCost::Create(std::move(cost)), nullptr,
+                               blocks);
     }
   }
   // Orientation blocks live on the unit quaternions.
@@ -969,7 +998,11 @@ const char* CameraMotionName(CameraMotion motion) {
   return motion == CameraMotion::kMoving ? "moving" : "static";
 }
 
-void FitOptions::Validate() const { CheckRanges(*this, "fit"); }
+void FitOptions::Validate() const {
+  CheckRanges(*this, "fit");
+  if (pitch_starts_deg.empty())
+    throw ConfigError("fit.pitch_starts_deg needs at least one pitch");
+}
 
 ViewEstimate FitView(const Clip2D& clip, const Character& character,
                      const FitOptions& options, const std::string& source) {
@@ -1004,11 +1037,15 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   Parameters best;
   double best_cost = std::numeric_limits<double>::infinity();
   double best_turn_deg = 0.0;
-  for (int k = 0; k < options.num_facing_starts; ++k) {
-    const double turn_deg = 360.0 * k / options.num_facing_starts;
-    Parameters params =
-        InitialParameters(obs, model, rest, options, priors.focal_px,
-                          M_PI + turn_deg * M_PI / 180.0);
+  double best_pitch_deg = options.pitch_starts_deg[0];
+  int num_starts_tried = 0;
+  // One start: stage 1 to convergence, then the screening solve; the lowest
+  // screening cost so far becomes `best`.
+  auto try_start = [&](double turn_deg, double pitch_deg,
+                       const std::string& name) {
+    Parameters params = InitialParameters(
+        obs, model, rest, options, priors.focal_px,
+        M_PI + turn_deg * M_PI / 180.0, pitch_deg * M_PI / 180.0);
     const StageResult root =
         SolveStage(Stage::kRoot, options.root_stage_iterations, obs, model,
                    *clip.layout, options, priors, nullptr, params);
@@ -1016,23 +1053,44 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
         SolveStage(Stage::kPose, options.screening_iterations, obs, model,
                    *clip.layout, options, priors, nullptr, params);
     summary.iterations += root.iterations + screen.iterations;
+    if (num_starts_tried++ == 0) summary.initial_cost = root.initial_cost;
     char line[200];
     std::snprintf(line, sizeof(line),
-                  "stages 1-2, start %d/%d (turned %.0f deg from facing the "
-                  "camera): camera + root cost %.4g -> %.4g, full pose %.4g",
-                  k + 1, options.num_facing_starts, turn_deg, root.initial_cost,
-                  root.final_cost, screen.final_cost);
+                  "stages 1-2, %s: camera + root cost %.4g -> %.4g, full "
+                  "pose %.4g",
+                  name.c_str(), root.initial_cost, root.final_cost,
+                  screen.final_cost);
     say(line);
-    if (k == 0) summary.initial_cost = root.initial_cost;
     if (screen.final_cost < best_cost) {
       best = std::move(params);
       best_cost = screen.final_cost;
       best_turn_deg = turn_deg;
+      best_pitch_deg = pitch_deg;
     }
+  };
+  for (int k = 0; k < options.num_facing_starts; ++k) {
+    const double turn_deg = 360.0 * k / options.num_facing_starts;
+    char name[96];
+    std::snprintf(name, sizeof(name),
+                  "start %d/%d (turned %.0f deg from facing the camera)", k + 1,
+                  options.num_facing_starts, turn_deg);
+    try_start(turn_deg, options.pitch_starts_deg[0], name);
   }
-  char label[64];
-  std::snprintf(label, sizeof(label), "turned %.0f deg from facing the camera",
-                best_turn_deg);
+  // The best facing again from the other camera pitches: a camera looking
+  // down on an upright body and a level one on a body leaning toward it
+  // project almost alike, and a local solve from level does not cross
+  // between the two.
+  const double facing_deg = best_turn_deg;
+  for (size_t p = 1; p < options.pitch_starts_deg.size(); ++p) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "pitch start %zu/%zu (%.0f deg)", p + 1,
+                  options.pitch_starts_deg.size(), options.pitch_starts_deg[p]);
+    try_start(facing_deg, options.pitch_starts_deg[p], name);
+  }
+  char label[96];
+  std::snprintf(label, sizeof(label),
+                "turned %.0f deg from facing the camera, pitch start %.0f deg",
+                best_turn_deg, best_pitch_deg);
   summary.initialization = label;
 
   // Stage 1b: each limb searched from a grid of starts, frame by frame.

@@ -90,16 +90,21 @@ struct FitOptions {
   double focal_prior_weight = 2.0;      // log(focal / prior)
   double upright_weight = 0.5;          // root up axis, horizontal part
   double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
+  // Balance (stage 3, frames with a sole in contact): the zero-moment point
+  // outside the in-contact soles' box grown by the margin (m); the centre
+  // of mass's acceleration over +-balance_span_s.
+  double balance_weight = 30.0;
+  double balance_margin_m = 0.05;
+  double balance_span_s = 0.1;
   // The camera's height is weakly observable when the subject stays at one
   // depth (a following camera): a prior at eye level, log(height / this).
   double camera_height_prior_m = 1.5;
   double camera_height_prior_weight = 1.0;
-  // The same prior for a moving camera (spread over its centres). Stronger:
-  // at one depth only height - depth x tan(pitch) is observed, and at 1 two
-  // of four following views of the walk settled 0.7 m low, looking level
-  // (docs/fit.md). A static camera sees the subject change depth; 5 there
-  // pulled the test rig's 2.06 m camera to 1.54 m and rolled it 8-10 deg.
-  double moving_camera_height_prior_weight = 5.0;
+  // The same prior for a moving camera (spread over its centres). At one
+  // depth only height - depth x tan(pitch) is observed; at 5 (before the
+  // pitch starts) it held a following 25-deg camera at eye level, looking
+  // level at a leaning body (docs/fit.md, schedule step 3).
+  double moving_camera_height_prior_weight = 1.0;
   // Soles within this height of the floor count as in contact (for the
   // foot-slide term), weight falling off as exp(-height / this).
   double contact_height_m = 0.005;
@@ -113,6 +118,10 @@ struct FitOptions {
   // each gets stage 1 and a short stage 2, and the lowest full-pose cost
   // continues.
   int num_facing_starts = 4;
+  // Camera pitches (deg, positive looks down) the search starts from: every
+  // facing start at the first, then the best facing at each of the others;
+  // the lowest full-pose cost continues.
+  std::vector<double> pitch_starts_deg = {0.0, 20.0, 40.0};
   // Solver: iterations per stage (and per round of stage 3).
   int root_stage_iterations = 20;  // stage 1, per facing start
   int limb_search_iterations = 5;  // per limb start and frame; 0: off
@@ -176,6 +185,12 @@ struct FitOptions {
       "horizontal part of the root's up axis");
     v("camera_roll_prior_weight", self.camera_roll_prior_weight, weight,
       "camera roll (rad) from level");
+    v("balance_weight", self.balance_weight, weight,
+      "zero-moment point outside the contact soles' box (m)");
+    v("balance_margin_m", self.balance_margin_m, Range::AtLeast(0),
+      "the support box grown by this (m)");
+    v("balance_span_s", self.balance_span_s, Range::Above(0),
+      "centre-of-mass acceleration over +- this (s)");
     v("camera_height_prior_m", self.camera_height_prior_m, Range::Above(0),
       "camera height prior (m), eye level");
     v("camera_height_prior_weight", self.camera_height_prior_weight, weight,
@@ -191,6 +206,9 @@ struct FitOptions {
       "full-pose solves, contacts relabelled before each");
     v("num_facing_starts", self.num_facing_starts, Range::Closed(1, 16),
       "headings tried for the facing ambiguity");
+    v("pitch_starts_deg", self.pitch_starts_deg, Range::Closed(-60, 60),
+      "camera pitches (deg) the search starts from; the first for every "
+      "facing start");
     v("root_stage_iterations", self.root_stage_iterations,
       Range::Closed(1, 100000), "stage 1 iterations per facing start");
     v("limb_search_iterations", self.limb_search_iterations,

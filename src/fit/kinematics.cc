@@ -41,96 +41,145 @@ std::vector<Eigen::Vector3d> SoleCorners(const mjModel* model, int body) {
 
 }  // namespace
 
+namespace {
+
+// One pose's joint frames and what every point's pose Jacobian needs: each
+// hinge's world axis (its sign folded in), the rotation's derivatives in the
+// quaternion, and which joint carries the quaternion.
+class PoseJacobianContext {
+ public:
+  PoseJacobianContext(const KinematicModel& model,
+                      const double* root_position_m,
+                      const double* root_quaternion_wxyz,
+                      const double* hinges_rad)
+      : model_(model), hinge_axis_(model.num_hinges()) {
+    using Eigen::Matrix3d;
+    using Eigen::Vector3d;
+    JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
+                orientation_, position_);
+    const int num_joints = static_cast<int>(model.joints.size());
+    for (int j = 0; j < num_joints; ++j) {
+      const KinematicModel::Joint& joint = model.joints[j];
+      const Matrix3d parent =
+          joint.parent < 0 ? Matrix3d::Identity() : orientation_[joint.parent];
+      if (joint.type == JointType::kSpherical) {
+        // Rx(a) Ry(b) Rz(c): each axis as the preceding rotations leave it.
+        const double* angles = hinges_rad + joint.first_hinge;
+        const Matrix3d rx =
+            fk_internal::AxisRotation<double>(Vector3d::UnitX(), angles[0]);
+        const Matrix3d ry =
+            fk_internal::AxisRotation<double>(Vector3d::UnitY(), angles[1]);
+        hinge_axis_[joint.first_hinge] = parent.col(0);
+        hinge_axis_[joint.first_hinge + 1] = parent * rx.col(1);
+        hinge_axis_[joint.first_hinge + 2] = parent * (rx * ry).col(2);
+      } else if (joint.type == JointType::kRevolute) {
+        hinge_axis_[joint.first_hinge] =
+            joint.revolute_sign * (parent * joint.axis);
+      }
+      if (joint.type == JointType::kFree) free_joint_ = j;
+    }
+    Jet4 quaternion[4];
+    for (int k = 0; k < 4; ++k)
+      quaternion[k] = Jet4(root_quaternion_wxyz[k], k);
+    ceres::QuaternionToRotation(quaternion, rotation_);
+  }
+
+  // `point`'s world position, and `scale` x its 3 pose Jacobian rows added
+  // into `rows` (PoseJacobianColumns wide each).
+  Eigen::Vector3d AddPoint(const BodyPoint& point, double scale,
+                           double* const rows[3]) const {
+    using Eigen::Vector3d;
+    const Vector3d world =
+        position_[point.joint] + orientation_[point.joint] * point.offset_m;
+    for (int c = 0; c < 3; ++c) rows[c][c] += scale;
+    if (free_joint_ >= 0) {
+      const Vector3d in_root = orientation_[free_joint_].transpose() *
+                               (world - position_[free_joint_]);
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 4; ++k) {
+          rows[c][kRootPositionSize + k] +=
+              scale * (rotation_[3 * c].v[k] * in_root[0] +
+                       rotation_[3 * c + 1].v[k] * in_root[1] +
+                       rotation_[3 * c + 2].v[k] * in_root[2]);
+        }
+    }
+    constexpr int kFirstHingeColumn = kRootPositionSize + kRootQuaternionSize;
+    for (int j = point.joint; j >= 0; j = model_.joints[j].parent) {
+      const KinematicModel::Joint& joint = model_.joints[j];
+      const int dofs = joint.type == JointType::kSpherical  ? 3
+                       : joint.type == JointType::kRevolute ? 1
+                                                            : 0;
+      const Vector3d lever = world - position_[j];
+      for (int d = 0; d < dofs; ++d) {
+        const int hinge = joint.first_hinge + d;
+        const Vector3d moved = hinge_axis_[hinge].cross(lever);
+        for (int c = 0; c < 3; ++c)
+          rows[c][kFirstHingeColumn + hinge] += scale * moved[c];
+      }
+    }
+    return world;
+  }
+
+ private:
+  using Jet4 = ceres::Jet<double, 4>;
+  const KinematicModel& model_;
+  Eigen::Matrix3d orientation_[kMaxFitJoints];
+  Eigen::Vector3d position_[kMaxFitJoints];
+  std::vector<Eigen::Vector3d> hinge_axis_;
+  Jet4 rotation_[9];  // row-major, with d/dq_k
+  int free_joint_ = -1;
+};
+
+}  // namespace
+
 void CharacterPointsWithJacobian(const KinematicModel& model,
                                  const double* root_position_m,
                                  const double* root_quaternion_wxyz,
                                  const double* hinges_rad, double* points_m,
                                  double* jacobian) {
-  // Outline: the joint frames; each hinge's world axis (its sign folded in)
-  // and pivot; the rotation's derivatives in the quaternion (4-wide Jets
-  // through the same conversion the frames use); then per point its
-  // position and one Jacobian row block: identity for the root position,
-  // dR/dq u for the quaternion, axis x (point - pivot) for every hinge of
-  // the joints above it.
-  using Eigen::Matrix3d;
-  using Eigen::Vector3d;
-  Matrix3d orientation[kMaxFitJoints];
-  Vector3d position[kMaxFitJoints];
-  JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
-              orientation, position);
-  const int num_joints = static_cast<int>(model.joints.size());
-  const int num_hinges = model.num_hinges();
-  std::vector<Vector3d> hinge_axis(num_hinges);
-  for (int j = 0; j < num_joints; ++j) {
-    const KinematicModel::Joint& joint = model.joints[j];
-    const Matrix3d parent =
-        joint.parent < 0 ? Matrix3d::Identity() : orientation[joint.parent];
-    if (joint.type == JointType::kSpherical) {
-      // Rx(a) Ry(b) Rz(c): each axis as the preceding rotations leave it.
-      const double* angles = hinges_rad + joint.first_hinge;
-      const Matrix3d rx =
-          fk_internal::AxisRotation<double>(Vector3d::UnitX(), angles[0]);
-      const Matrix3d ry =
-          fk_internal::AxisRotation<double>(Vector3d::UnitY(), angles[1]);
-      hinge_axis[joint.first_hinge] = parent.col(0);
-      hinge_axis[joint.first_hinge + 1] = parent * rx.col(1);
-      hinge_axis[joint.first_hinge + 2] = parent * (rx * ry).col(2);
-    } else if (joint.type == JointType::kRevolute) {
-      hinge_axis[joint.first_hinge] =
-          joint.revolute_sign * (parent * joint.axis);
-    }
-  }
-  // dR/dq_k, and which joint carries the quaternion.
-  using Jet4 = ceres::Jet<double, 4>;
-  Jet4 quaternion[4], rotation[9];
-  for (int k = 0; k < 4; ++k) quaternion[k] = Jet4(root_quaternion_wxyz[k], k);
-  ceres::QuaternionToRotation(quaternion, rotation);
-  int free_joint = -1;
-  for (int j = 0; j < num_joints; ++j) {
-    if (model.joints[j].type == JointType::kFree) free_joint = j;
-  }
-
+  // Outline: the joint frames, hinge axes and dR/dq once; then per point
+  // its position and one Jacobian row block: identity for the root
+  // position, dR/dq u for the quaternion, axis x (point - pivot) for every
+  // hinge of the joints above it.
+  const PoseJacobianContext context(model, root_position_m,
+                                    root_quaternion_wxyz, hinges_rad);
   const int columns = PoseJacobianColumns(model);
-  constexpr int kFirstHingeColumn = kRootPositionSize + kRootQuaternionSize;
+  const int num_points = model.num_keypoints() + model.num_sole_points();
+  std::fill(jacobian, jacobian + 3 * num_points * columns, 0.0);
   int row = 0;
   for (const std::vector<BodyPoint>* points :
        {&model.keypoints, &model.sole_points}) {
     for (const BodyPoint& point : *points) {
-      const Vector3d world =
-          position[point.joint] + orientation[point.joint] * point.offset_m;
+      double* const rows[3] = {jacobian + row * columns,
+                               jacobian + (row + 1) * columns,
+                               jacobian + (row + 2) * columns};
+      const Eigen::Vector3d world = context.AddPoint(point, 1.0, rows);
       for (int c = 0; c < 3; ++c) points_m[row + c] = world[c];
-      double* rows[3] = {jacobian + row * columns,
-                         jacobian + (row + 1) * columns,
-                         jacobian + (row + 2) * columns};
-      for (double* r : rows) std::fill(r, r + columns, 0.0);
-      for (int c = 0; c < 3; ++c) rows[c][c] = 1.0;
-      if (free_joint >= 0) {
-        const Vector3d in_root = orientation[free_joint].transpose() *
-                                 (world - position[free_joint]);
-        for (int c = 0; c < 3; ++c)
-          for (int k = 0; k < 4; ++k) {
-            rows[c][kRootPositionSize + k] =
-                rotation[3 * c].v[k] * in_root[0] +
-                rotation[3 * c + 1].v[k] * in_root[1] +
-                rotation[3 * c + 2].v[k] * in_root[2];
-          }
-      }
-      for (int j = point.joint; j >= 0; j = model.joints[j].parent) {
-        const KinematicModel::Joint& joint = model.joints[j];
-        const int dofs = joint.type == JointType::kSpherical  ? 3
-                         : joint.type == JointType::kRevolute ? 1
-                                                              : 0;
-        const Vector3d lever = world - position[j];
-        for (int d = 0; d < dofs; ++d) {
-          const int hinge = joint.first_hinge + d;
-          const Vector3d moved = hinge_axis[hinge].cross(lever);
-          for (int c = 0; c < 3; ++c)
-            rows[c][kFirstHingeColumn + hinge] = moved[c];
-        }
-      }
       row += 3;
     }
   }
+}
+
+void CenterOfMassWithJacobian(const KinematicModel& model,
+                              const double* root_position_m,
+                              const double* root_quaternion_wxyz,
+                              const double* hinges_rad, double* com_m,
+                              double* jacobian) {
+  // Outline: the mass-weighted sum of the bodies' centres and of their
+  // Jacobian rows.
+  const PoseJacobianContext context(model, root_position_m,
+                                    root_quaternion_wxyz, hinges_rad);
+  const int columns = PoseJacobianColumns(model);
+  std::fill(jacobian, jacobian + 3 * columns, 0.0);
+  double* const rows[3] = {jacobian, jacobian + columns,
+                           jacobian + 2 * columns};
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  for (size_t b = 0; b < model.mass_points.size(); ++b) {
+    com +=
+        model.mass_fractions[b] *
+        context.AddPoint(model.mass_points[b], model.mass_fractions[b], rows);
+  }
+  for (int c = 0; c < 3; ++c) com_m[c] = com[c];
 }
 
 KinematicModel KinematicModel::FromCharacter(const Character& character) {
@@ -160,6 +209,26 @@ KinematicModel KinematicModel::FromCharacter(const Character& character) {
     model.hinge_low_rad.push_back(hinge.range_low_rad);
     model.hinge_high_rad.push_back(hinge.range_high_rad);
   }
+  // Mass points: each joint's body's centre of mass (MuJoCo's body_ipos, in
+  // the body frame, which is the joint's) and its share of the total mass.
+  double total_mass_kg = 0.0;
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    const int body = character.joints()[j].body_id;
+    bool seen = false;
+    for (const BodyPoint& point : model.mass_points)
+      seen = seen || character.joints()[point.joint].body_id == body;
+    if (body <= 0 || seen || mj_model->body_mass[body] <= 0.0) continue;
+    model.mass_points.push_back(
+        {j, Eigen::Vector3d(mj_model->body_ipos + 3 * body)});
+    model.mass_fractions.push_back(mj_model->body_mass[body]);
+    total_mass_kg += mj_model->body_mass[body];
+  }
+  if (total_mass_kg <= 0.0) {
+    throw InputError(character.config().source_path,
+                     "the character's bodies have no mass: the fit's balance "
+                     "term needs their centres of mass");
+  }
+  for (double& fraction : model.mass_fractions) fraction /= total_mass_kg;
   // Sole points: a ground-contact body is the body of some skeleton joint;
   // its box geoms' lowest corners are where it meets the floor.
   for (int body : character.ground_contact_bodies()) {

@@ -44,6 +44,8 @@ struct KinematicModel {
   std::vector<BodyPoint> keypoints;    // in keypoint-layout order
   std::vector<BodyPoint> sole_points;  // contact bodies' lowest box corners
   std::vector<int> sole_foot;          // per sole point: 0 or 1, which foot
+  std::vector<BodyPoint> mass_points;  // each body's centre of mass
+  std::vector<double> mass_fractions;  // per mass point: its share, sum 1
   int num_feet = 0;
   std::vector<double> hinge_low_rad;  // MJCF ranges, in action order
   std::vector<double> hinge_high_rad;
@@ -195,6 +197,15 @@ void CharacterPointsWithJacobian(const KinematicModel& model,
                                  const double* root_quaternion_wxyz,
                                  const double* hinges_rad, double* points_m,
                                  double* jacobian);
+
+// The whole body's centre of mass (world, m) into `com_m` (3), with its
+// derivatives with respect to the pose in `jacobian` (row-major 3 x
+// PoseJacobianColumns): the mass-weighted mean of the bodies' centres.
+void CenterOfMassWithJacobian(const KinematicModel& model,
+                              const double* root_position_m,
+                              const double* root_quaternion_wxyz,
+                              const double* hinges_rad, double* com_m,
+                              double* jacobian);
 
 // A limb: a chain of joints hanging off the trunk (an arm, a leg, the
 // head), the hinges that move its keypoints, and those keypoints. Its

@@ -215,6 +215,32 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
                    fitted_path, "stripped? use cameras: estimate");
 }
 
+// `mimic2d prior` learns a mixture from a DeepMimic clip of the humanoid's
+// own skeleton and a CMU capture retargeted by its COCO-17 points, and names
+// a file that is neither.
+TEST(Cli, PriorLearnsFromOwnAndRetargetedMotion) {
+  const std::string dir = testing::TempDir("cli_prior");
+  const std::string output = dir + "/prior.json";
+  CommandResult result = RunMimic2d(
+      "prior " +
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+      " /usr/share/assimp/models/BVH/01_01.bvh --components 2 -o " + output);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("01_01.bvh: "), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("retargeted"), std::string::npos)
+      << result.output;
+  const nlohmann::json mixture = ReadJsonFile(output);
+  EXPECT_EQ(mixture["components"].size(), 2u);
+  ASSERT_EQ(mixture["sources"].size(), 2u);
+  EXPECT_EQ(mixture["sources"][0], "humanoid3d_walk.txt");
+  EXPECT_EQ(mixture["sources"][1], "01_01.bvh");
+  const std::string not_motion = WriteFile(dir, "notes.txt", "hello");
+  ExpectInputError("prior " + not_motion + " -o " + dir + "/x.json", not_motion,
+                   "");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.json"));
+}
+
 TEST(Cli, BadInputIsAClearErrorNotACrash) {
   std::string dir = testing::TempDir("cli_bad");
   std::string malformed =

@@ -113,6 +113,62 @@ TEST(FitKinematics, MatchesMujocoKeypointsAndSoles) {
   EXPECT_NEAR(model.standing_root_height_m, 0.881416, 1e-6);
 }
 
+// The fit's centre of mass is MuJoCo's (the mass-weighted mean of the
+// character's bodies' xipos), and its Jacobian matches central differences.
+TEST(FitKinematics, CenterOfMassMatchesMujocoAndItsJacobianDifferences) {
+  auto character = Humanoid();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  ASSERT_EQ(model.mass_points.size(), model.mass_fractions.size());
+  ASSERT_GT(model.mass_points.size(), 10u);
+  Simulation simulation(character, SimulationOptions());
+  const mjModel* mj = character->model();
+  std::mt19937_64 rng(11);
+  const int columns = PoseJacobianColumns(model);
+  for (int trial = 0; trial < 10; ++trial) {
+    RandomPose pose = MakeRandomPose(model, rng);
+    simulation.Reset();
+    simulation.SetPose(FittedPose(*character, pose.root_m.data(),
+                                  pose.quaternion_wxyz.data(),
+                                  pose.hinges_rad.data()));
+    Eigen::Vector3d expected = Eigen::Vector3d::Zero();
+    double mass_kg = 0.0;
+    for (int b = 1; b < mj->nbody; ++b) {
+      if (!character->IsCharacterBody(b)) continue;
+      expected +=
+          mj->body_mass[b] * Eigen::Vector3d(simulation.data()->xipos + 3 * b);
+      mass_kg += mj->body_mass[b];
+    }
+    expected /= mass_kg;
+    double com[3];
+    std::vector<double> jacobian(3 * columns);
+    CenterOfMassWithJacobian(model, pose.root_m.data(),
+                             pose.quaternion_wxyz.data(),
+                             pose.hinges_rad.data(), com, jacobian.data());
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(com[k], expected[k], 1e-9);
+    // Central differences in every pose column.
+    std::vector<double> flat(columns);
+    std::copy_n(pose.root_m.data(), 3, flat.begin());
+    std::copy_n(pose.quaternion_wxyz.data(), 4, flat.begin() + 3);
+    std::copy(pose.hinges_rad.begin(), pose.hinges_rad.end(), flat.begin() + 7);
+    for (int col = 0; col < columns; ++col) {
+      double plus[3], minus[3];
+      std::vector<double> scratch(3 * columns);
+      for (double sign : {1.0, -1.0}) {
+        std::vector<double> moved = flat;
+        moved[col] += sign * 1e-6;
+        CenterOfMassWithJacobian(model, moved.data(), moved.data() + 3,
+                                 moved.data() + 7, sign > 0 ? plus : minus,
+                                 scratch.data());
+      }
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(jacobian[k * columns + col], (plus[k] - minus[k]) / 2e-6,
+                    1e-5)
+            << "column " << col;
+      }
+    }
+  }
+}
+
 // The analytic pose Jacobian the per-frame costs use equals automatic
 // differentiation of the templated kinematics (exactly, up to rounding),
 // for random poses and an unnormalized quaternion.
@@ -242,6 +298,44 @@ TEST(FitCosts, EveryTermsJacobianMatchesFiniteDifferences) {
       {a.root_m.data(), a.quaternion_wxyz.data(), a.hinges_rad.data(),
        b.root_m.data(), b.quaternion_wxyz.data(), b.hinges_rad.data()},
       {none, none, none, none, none, none}, "foot slide");
+  // Balance: frame b standing on its soles, a and c displaced so that the
+  // centre of mass accelerates and the zero-moment point leaves the box.
+  BalanceCost balance;
+  balance.model = &model;
+  balance.in_contact.assign(8, false);
+  balance.in_contact[0] = balance.in_contact[2] = balance.in_contact[5] = true;
+  balance.span_s = 0.1;
+  balance.margin_m = 0.02;
+  balance.weight = 5.0;
+  RandomPose before = standing, after = standing;
+  before.root_m += Eigen::Vector3d(0.05, -0.03, 0.01);
+  after.root_m += Eigen::Vector3d(0.09, 0.04, -0.02);
+  before.hinges_rad[2] += 0.1;
+  after.hinges_rad[5] -= 0.1;
+  ExpectGradientsMatch(BalanceCost::Create(balance),
+                       {before.root_m.data(), before.quaternion_wxyz.data(),
+                        before.hinges_rad.data(), standing.root_m.data(),
+                        standing.quaternion_wxyz.data(),
+                        standing.hinges_rad.data(), after.root_m.data(),
+                        after.quaternion_wxyz.data(), after.hinges_rad.data()},
+                       {none, none, none, none, none, none, none, none, none},
+                       "balance");
+  {
+    // The same residual is active (outside the box) for this probe.
+    std::unique_ptr<ceres::CostFunction> cost(BalanceCost::Create(balance));
+    const double* blocks[9] = {before.root_m.data(),
+                               before.quaternion_wxyz.data(),
+                               before.hinges_rad.data(),
+                               standing.root_m.data(),
+                               standing.quaternion_wxyz.data(),
+                               standing.hinges_rad.data(),
+                               after.root_m.data(),
+                               after.quaternion_wxyz.data(),
+                               after.hinges_rad.data()};
+    double residuals[2];
+    ASSERT_TRUE(cost->Evaluate(blocks, residuals, nullptr));
+    EXPECT_GT(std::abs(residuals[0]) + std::abs(residuals[1]), 1e-3);
+  }
   LimbCost limb;
   limb.model = &model;
   limb.limb_hinges = {3, 4, 5, 6};
