@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "env/reference.h"
+#include "env/reference_stream.h"
 #include "env/task.h"
 #include "env/tracking_env.h"
 #include "env/vec_env.h"
@@ -168,6 +169,54 @@ void BM_TrackingEnvStep(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_TrackingEnvStep);
+
+// A control step of a rollout that follows a streamed reference
+// (StreamedRollout: the window of L + 1 frames prepared again and a
+// TrackingEnv started on it every step), actions replayed from the same
+// table; against BM_TrackingEnvStep, what streaming costs per step.
+void BM_StreamedRolloutStep(benchmark::State& state) {
+  const BenchTask& task = Task();
+  TrackingEnvOptions options = task.options;
+  options.early_exit = false;
+  class ReplayPolicy : public Policy {
+   public:
+    ReplayPolicy(const BenchTask& task, int size) : task_(task), size_(size) {}
+    void Act(const float*, int, float* actions) override {
+      const float* row = task_.action(step++);
+      std::copy(row, row + task_.character->num_actions(), actions);
+    }
+    int observation_size() const override { return size_; }
+    int action_size() const override { return task_.character->num_actions(); }
+    int step = 0;
+
+   private:
+    const BenchTask& task_;
+    int size_;
+  } policy(task, 0);
+  std::unique_ptr<ClipStream> stream;
+  std::unique_ptr<StreamedRollout> rollout;
+  int step = 0;
+  for (auto _ : state) {
+    if (step % kEpisodeSteps == 0) {
+      state.PauseTiming();
+      const int episode = step / kEpisodeSteps;
+      const ReferenceView& view =
+          task.reference->bundles()[0].views[task.view(episode)];
+      stream = std::make_unique<ClipStream>(view.clip);
+      rollout = std::make_unique<StreamedRollout>(
+          task.character, options, stream.get(),
+          [&view](int frame, const SimState&) { return view.CameraAt(frame); },
+          task.initial_states->BufferOfView(task.view(episode))
+              .entry(0, 0)
+              .state);
+      state.ResumeTiming();
+    }
+    benchmark::DoNotOptimize(rollout->Step(policy));
+    ++step;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_StreamedRolloutStep);
 
 // The observation alone (body kinematics, proprioception, 2D block).
 void BM_WriteObservation(benchmark::State& state) {
