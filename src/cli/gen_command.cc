@@ -11,12 +11,18 @@
 #include "camera/rig.h"
 #include "cli/commands.h"
 #include "cli/motion_source.h"
+#include "cli/policy_runs.h"
 #include "common/error.h"
 #include "common/file_io.h"
+#include "env/reference.h"
+#include "env/reference_stream.h"
 #include "gen/gen_config.h"
 #include "gen/gen_trainer.h"
+#include "gen/generated_stream.h"
 #include "gen/generator.h"
 #include "motion/clip_io.h"
+#include "render/episode_renderer.h"
+#include "rl/torch_policy.h"
 
 namespace m2d::cli {
 namespace {
@@ -109,12 +115,15 @@ struct GenerateArgs {
   int top_k = 0;
   std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
   double focal_px = 1000.0;
+  // --policy: a tracker checkpoint driven along `generations` streams
+  // (seeds seed, seed + 1, ...); --video: the first one drawn.
+  std::string policy;
+  int generations = 1;
+  std::string video;
 };
 
-// The first frame's root and scale: the character standing at the origin,
-// seen from the chosen view (what the tracker starts from).
-void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
-                       double* scale_px) {
+// The chosen view's camera: the rig's, aimed at the origin.
+PinholeCamera ViewCamera(const GenerateArgs& args) {
   RigOptions rig;
   rig.num_views = 1;
   rig.first_azimuth_deg = args.view[0];
@@ -122,7 +131,14 @@ void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
   rig.distance_m = args.view[2];
   rig.focal_px = args.focal_px;
   rig.Validate();
-  const PinholeCamera camera = MakeRig(rig).front().camera;
+  return MakeRig(rig).front().camera;
+}
+
+// The first frame's root and scale: the character standing at the origin,
+// seen from the chosen view (what the tracker starts from).
+void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
+                       double* scale_px) {
+  const PinholeCamera camera = ViewCamera(args);
   auto skeleton = std::make_shared<const Skeleton>(
       LoadSkeleton(AssetPath("skeletons/humanoid.yaml")));
   const KeypointMap map =
@@ -149,9 +165,102 @@ void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
   }
 }
 
+// The checkpoint's tracker along `args.generations` generated streams seen
+// from --view: each starts from the default pose placed under the
+// placement, and the camera dollies with the simulated character (the
+// generator learned from cameras that followed the subject). A rollout
+// succeeds when it tracks --seconds without an early exit. Prints a line
+// per generation and the totals; draws the first with --video.
+int RunTrackedGenerations(const GenerateArgs& args, Eigen::Vector2d root_px,
+                          double scale_px) {
+  TorchPolicy policy(args.policy);
+  const TrainConfig& config = policy.config();
+  const auto character = LoadCharacterForSimulation(
+      TrainedCharacterPath(config), config.data.scene, config.env.simulation);
+  TrackingEnvOptions env_options = config.env;
+  env_options.max_episode_s = args.seconds;
+  const PinholeCamera first_camera = ViewCamera(args);
+  const SimState start = PlacedDefaultState(character, config.env.simulation,
+                                            first_camera, {root_px, scale_px});
+  const int root = character->root_qpos_address();
+  int succeeded = 0;
+  double e2d_sum_px = 0.0;
+  std::printf(
+      "tracking with %s: %d generation(s) x %.0f s, view %.0f,%.0f,%.1f\n",
+      args.policy.c_str(), args.generations, args.seconds, args.view[0],
+      args.view[1], args.view[2]);
+  for (int g = 0; g < args.generations; ++g) {
+    GeneratedStreamOptions stream_options;
+    stream_options.sampling = {args.temperature, args.top_k};
+    stream_options.seed = args.seed + g;
+    stream_options.first_root_px = root_px;
+    stream_options.first_scale_px = scale_px;
+    stream_options.image_width_px = first_camera.intrinsics().width_px;
+    stream_options.image_height_px = first_camera.intrinsics().height_px;
+    GeneratedStream stream(args.run_dir, stream_options);
+    StreamedRollout rollout(
+        character, env_options, &stream,
+        [&](int, const SimState& state) {
+          return first_camera.Translated(
+              {state.qpos[root] - start.qpos[root],
+               state.qpos[root + 1] - start.qpos[root + 1], 0.0});
+        },
+        start);
+    std::vector<EpisodeFrame> frames;
+    auto record = [&] {
+      if (g != 0 || args.video.empty()) return;
+      EpisodeFrame frame;
+      frame.clip_frame = rollout.frame();
+      frame.camera = rollout.camera();
+      frame.reference = rollout.reference_frame();
+      frame.state = rollout.simulation().Save();
+      frames.push_back(std::move(frame));
+    };
+    record();
+    const auto started = std::chrono::steady_clock::now();
+    while (rollout.Step(policy)) record();
+    record();
+    const double wall_s = std::chrono::duration<double>(
+                              std::chrono::steady_clock::now() - started)
+                              .count();
+    const EpisodeStats& stats = rollout.stats();
+    succeeded += stats.failed ? 0 : 1;
+    e2d_sum_px += stats.mean_error_px();
+    std::printf(
+        "  generation %d (seed %llu): %s after %d of %d frames, E2D %.1f px, "
+        "%.0fx real time\n",
+        g + 1, static_cast<unsigned long long>(stream_options.seed),
+        stats.failed ? "lost (early exit)" : "tracked to the end", stats.steps,
+        env_options.max_episode_steps(), stats.mean_error_px(),
+        stats.steps / config.env.simulation.control_hz /
+            std::max(1e-9, wall_s));
+    std::fflush(stdout);
+    if (!frames.empty()) {
+      RecordedFrames recorded(std::move(frames));
+      Clip2D format = stream.format();
+      BundleReplayOptions replay;
+      replay.output.video_path = args.video;
+      EpisodeRenderOptions render;
+      render.pose_label = "character (policy)";
+      render.reference_label = "generated 2D";
+      const EpisodeSummary summary =
+          RenderViewFrames(recorded, character, config.env.simulation, format,
+                           format.fps, render, replay);
+      std::printf("  wrote %s (%d frames)\n", summary.video_path.c_str(),
+                  summary.frames_rendered);
+    }
+  }
+  std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px\n", succeeded,
+              args.generations, 100.0 * succeeded / args.generations,
+              e2d_sum_px / args.generations);
+  return 0;
+}
+
 int RunGenerate(const GenerateArgs& args) {
   if (args.view.size() != 3)
     throw ConfigError("generate: --view takes azimuth,elevation,distance");
+  if (args.policy.empty() && (!args.video.empty() || args.generations != 1))
+    throw ConfigError("generate: --video and --generations need --policy");
   SamplingOptions sampling;
   sampling.temperature = args.temperature;
   sampling.top_k = args.top_k;
@@ -171,7 +280,8 @@ int RunGenerate(const GenerateArgs& args) {
       "%.2f s (%.0fx real time)\n",
       args.output.c_str(), frames, fps, frames / fps, motion.num_codes,
       motion.generation_s, frames / fps / std::max(1e-9, motion.generation_s));
-  return 0;
+  if (args.policy.empty()) return 0;
+  return RunTrackedGenerations(args, root_px, scale_px);
 }
 
 struct GenEvalArgs {
@@ -317,6 +427,18 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->expected(3);
   generate->add_option("--focal", generate_args->focal_px,
                        "Camera focal length (px)");
+  generate
+      ->add_option("--policy", generate_args->policy,
+                   "A tracker checkpoint to drive along the generated 2D, "
+                   "streamed frame by frame, the camera dollying with the "
+                   "character")
+      ->check(CLI::ExistingFile);
+  generate
+      ->add_option("--generations", generate_args->generations,
+                   "With --policy: streams to track (seeds seed, seed+1, ...)")
+      ->check(CLI::Range(1, 10000));
+  generate->add_option("--video", generate_args->video,
+                       "With --policy: the first tracked stream drawn (MP4)");
   generate->callback([run, generate_args] {
     *run = [generate_args] { return RunGenerate(*generate_args); };
   });

@@ -16,19 +16,6 @@
 namespace m2d::cli {
 namespace {
 
-// Checkpoints keep the training's paths, relative to where it ran (the
-// repository root); from elsewhere, find the character there.
-std::string TrainedCharacterPath(const TrainConfig& config) {
-  std::string path = config.data.character_config;
-  if (!std::filesystem::exists(path) &&
-      std::filesystem::path(path).is_relative()) {
-    const std::string in_repository =
-        std::string(MIMIC2D_SOURCE_DIR) + "/" + path;
-    if (std::filesystem::exists(in_repository)) path = in_repository;
-  }
-  return path;
-}
-
 // The task a trained policy runs in: its config's simulation, the sources
 // (overridden where asked), noise-free initial states (sigma 0, default
 // buffers), whatever the run trained with.
@@ -98,6 +85,17 @@ nlohmann::json RowToJson(const EvalRow& row) {
 }
 
 }  // namespace
+
+std::string TrainedCharacterPath(const TrainConfig& config) {
+  std::string path = config.data.character_config;
+  if (!std::filesystem::exists(path) &&
+      std::filesystem::path(path).is_relative()) {
+    const std::string in_repository =
+        std::string(MIMIC2D_SOURCE_DIR) + "/" + path;
+    if (std::filesystem::exists(in_repository)) path = in_repository;
+  }
+  return path;
+}
 
 CheckpointEvaluation EvaluateCheckpoint(
     const std::string& checkpoint, const std::vector<std::string>& bundle_paths,

@@ -12,8 +12,14 @@
 #include "eval/evaluator.h"
 #include "motion/bundle.h"
 #include "render/episode_renderer.h"
+#include "rl/train_config.h"
 
 namespace m2d::cli {
+
+// The character config a checkpoint trained with. Checkpoints keep the
+// training's paths, relative to where it ran (the repository root); from
+// elsewhere, it is found there.
+std::string TrainedCharacterPath(const TrainConfig& config);
 
 // Where a policy run's starts and cameras come from: each unset field
 // keeps the checkpoint's training config.

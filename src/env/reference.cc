@@ -385,4 +385,16 @@ InitialStates::InitialStates(const TrackingReference& reference,
   }
 }
 
+SimState PlacedDefaultState(std::shared_ptr<const Character> character,
+                            const SimulationOptions& simulation_options,
+                            const PinholeCamera& camera,
+                            const ImageNormalization& image) {
+  Simulation simulation(character, simulation_options);
+  simulation.Reset();
+  const Pose3D standing = QposToPose(*character, simulation.data()->qpos);
+  simulation.SetPose(PlaceDefaultPose(
+      *character, standing, SimulatedKeypoints(simulation), camera, image));
+  return simulation.Save();
+}
+
 }  // namespace m2d

@@ -79,6 +79,15 @@ uint64_t ReferenceFingerprint(const TrackingReference& reference);
 void ReadBodyTarget(const Simulation& simulation, const double* keypoints_xyz,
                     BodyTarget3D* target);
 
+// The `default` initial state of a frame seen by `camera` whose image root
+// and scale are `image`: the model's default pose, turned to face the
+// camera and moved so that its root keypoints project onto the 2D root, at
+// the height they have standing; at rest.
+SimState PlacedDefaultState(std::shared_ptr<const Character> character,
+                            const SimulationOptions& simulation_options,
+                            const PinholeCamera& camera,
+                            const ImageNormalization& image);
+
 // Initial-state buffers. From the truth or the default pose, one per bundle
 // (frames are shared by its views: they show the same motion, in one world
 // frame); from an estimate, one per view (each view's poses are in its own

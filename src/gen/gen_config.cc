@@ -93,4 +93,9 @@ std::string GenSettingsReference() {
       [](const auto& c, auto visit) { ForEachGenSection(c, visit); });
 }
 
+void SamplingOptions::Validate() const {
+  if (!(temperature > 0) || top_k < 0)
+    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
+}
+
 }  // namespace m2d

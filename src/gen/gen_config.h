@@ -131,6 +131,7 @@ struct GptOptions {
 struct SamplingOptions {
   double temperature = 1.0;  // > 0; lower is greedier
   int top_k = 0;             // sample among the k likeliest codes (0: all)
+  void Validate() const;     // throws ConfigError
 };
 
 // How the stream decodes codes into frames (gen/motion_stream.h).

@@ -44,8 +44,7 @@ GeneratedMotion Generate(const LoadedTokenizer& tokenizer,
 }
 
 void CheckGeneration(double seconds, const SamplingOptions& sampling) {
-  if (!(sampling.temperature > 0) || sampling.top_k < 0)
-    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
+  sampling.Validate();
   if (!(seconds > 0 && seconds <= 24 * 3600))
     throw ConfigError("generation length must be in (0, 86400] s");
 }

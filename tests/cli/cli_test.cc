@@ -73,6 +73,44 @@ TEST(Cli, BvhDemoMotionBecomesABundle) {
   EXPECT_EQ(ReadBundle(dir + "/b.json").views.size(), 2u);
 }
 
+// `generate --policy`: a tracker driven along generated 2D streamed frame
+// by frame (a tiny generator trained here, the committed walk2d tracker), a
+// line per stream, the totals and the first stream drawn.
+TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
+  const std::string dir = testing::TempDir("cli_generate");
+  const std::string config = WriteFile(
+      dir, "tiny.yaml",
+      "data:\n  motions: [" +
+          testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+          "]\n  loop_to_s: 4\n  num_azimuths: 2\n  elevations_deg: [10]\n"
+          "tokenizer:\n  num_codes: 16\n  code_size: 16\n  width: 32\n"
+          "  residual_depth: 1\n  window_frames: 16\n  batch_size: 4\n"
+          "  steps: 6\n"
+          "prior:\n  num_layers: 1\n  num_heads: 2\n  embedding: 16\n"
+          "  context_tokens: 8\n  batch_size: 4\n  steps: 4\n"
+          "run:\n  run_dir: " +
+          dir + "/gen\n  torch_threads: 1\n");
+  CommandResult result = RunMimic2d("gen train " + config);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::string policy =
+      testing::SourcePath("assets/policies/walk2d/checkpoint.pt");
+  result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
+                      policy + " --generations 2 --video " + dir +
+                      "/tracked.mp4 -o " + dir + "/generated.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("generation 2 (seed 2): "), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("Succ "), std::string::npos) << result.output;
+  EXPECT_GT(std::filesystem::file_size(dir + "/tracked.mp4"), 1000u);
+  EXPECT_EQ(ReadClip(dir + "/generated.json").num_frames(), 60);
+  // The tracking options need a tracker.
+  result = RunMimic2d("generate " + dir + "/gen --video " + dir + "/x.mp4 -o " +
+                      dir + "/x.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("need --policy"), std::string::npos)
+      << result.output;
+}
+
 // Each bad input: exit code 2, one line naming the file and the problem.
 void ExpectInputError(const std::string& arguments, const std::string& file,
                       const std::string& problem) {

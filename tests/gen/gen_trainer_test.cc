@@ -10,8 +10,10 @@
 #include "common/file_io.h"
 #include "gen/gen_checkpoint.h"
 #include "gen/gen_test_data.h"
+#include "gen/generated_stream.h"
 #include "gen/generator.h"
 #include "gen/motion_stream.h"
+#include "motion/canonical.h"
 
 namespace m2d {
 namespace {
@@ -112,6 +114,44 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
       MotionStream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
                    LoadPrior(config.run.run_dir + "/prior.pt"), options),
       ConfigError);
+}
+
+// Streamed frame by frame, the generator gives the clip `generate` writes
+// for the same seed and placement: the same codes, decoded alike, turned
+// into absolute 2D by the same recurrence.
+TEST(GenTrainer, TheGeneratedStreamIsTheGeneratedClip) {
+  const GenConfig config = TinyConfig(TempRun("generated_stream"));
+  TrainGenerator(config, WalkDataset(), false, nullptr, nullptr);
+  const SamplingOptions sampling{0.9, 0};
+  const GeneratedMotion motion =
+      GenerateMotion(config.run.run_dir, 3.0, sampling, 7);
+  const Eigen::Vector2d root_px(900, 600);
+  const double scale_px = 80.0;
+  const Clip2D clip = FromCanonical(
+      CanonicalFromFeatures(motion.rows.data(), motion.num_frames,
+                            Coco17Layout(), motion.fps, root_px, scale_px));
+  GeneratedStreamOptions options;
+  options.sampling = sampling;
+  options.seed = 7;
+  options.first_root_px = root_px;
+  options.first_scale_px = scale_px;
+  GeneratedStream stream(config.run.run_dir, options);
+  EXPECT_EQ(stream.format().layout, &Coco17Layout());
+  EXPECT_DOUBLE_EQ(stream.format().fps, motion.fps);
+  std::vector<Keypoint2D> frame;
+  double worst_px = 0.0;
+  for (int t = 0; t < clip.num_frames(); ++t) {
+    ASSERT_TRUE(stream.Next(&frame));
+    ASSERT_EQ(frame.size(), 17u);
+    for (int j = 0; j < 17; ++j) {
+      worst_px = std::max(
+          {worst_px, std::abs(frame[j].x_px - clip.keypoints.at(t, j).x_px),
+           std::abs(frame[j].y_px - clip.keypoints.at(t, j).y_px)});
+    }
+  }
+  EXPECT_LT(worst_px, 1e-6);
+  options.sampling.temperature = 0.0;
+  EXPECT_THROW(GeneratedStream(config.run.run_dir, options), ConfigError);
 }
 
 TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
