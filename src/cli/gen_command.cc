@@ -119,14 +119,16 @@ struct GenerateArgs {
   // (seeds seed, seed + 1, ...); --video: the first one drawn.
   std::string policy;
   int generations = 1;
+  std::vector<double> azimuths_deg;  // with --policy: views (default --view's)
   std::string video;
 };
 
-// The chosen view's camera: the rig's, aimed at the origin.
-PinholeCamera ViewCamera(const GenerateArgs& args) {
+// The camera at `azimuth_deg` and --view's elevation and distance: the
+// rig's, aimed at the origin.
+PinholeCamera ViewCamera(const GenerateArgs& args, double azimuth_deg) {
   RigOptions rig;
   rig.num_views = 1;
-  rig.first_azimuth_deg = args.view[0];
+  rig.first_azimuth_deg = azimuth_deg;
   rig.elevation_deg = args.view[1];
   rig.distance_m = args.view[2];
   rig.focal_px = args.focal_px;
@@ -135,10 +137,9 @@ PinholeCamera ViewCamera(const GenerateArgs& args) {
 }
 
 // The first frame's root and scale: the character standing at the origin,
-// seen from the chosen view (what the tracker starts from).
-void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
+// seen by `camera` (what the tracker starts from).
+void StandingPlacement(const PinholeCamera& camera, Eigen::Vector2d* root_px,
                        double* scale_px) {
-  const PinholeCamera camera = ViewCamera(args);
   auto skeleton = std::make_shared<const Skeleton>(
       LoadSkeleton(AssetPath("skeletons/humanoid.yaml")));
   const KeypointMap map =
@@ -171,73 +172,83 @@ void StandingPlacement(const GenerateArgs& args, Eigen::Vector2d* root_px,
 // generator learned from cameras that followed the subject). A rollout
 // succeeds when it tracks --seconds without an early exit. Prints a line
 // per generation and the totals; draws the first with --video.
-int RunTrackedGenerations(const GenerateArgs& args, Eigen::Vector2d root_px,
-                          double scale_px) {
+int RunTrackedGenerations(const GenerateArgs& args) {
   TorchPolicy policy(args.policy);
   const TrainConfig& config = policy.config();
   const auto character = LoadCharacterForSimulation(
       TrainedCharacterPath(config), config.data.scene, config.env.simulation);
   TrackingEnvOptions env_options = config.env;
   env_options.max_episode_s = args.seconds;
-  const PinholeCamera first_camera = ViewCamera(args);
-  const SimState start = PlacedDefaultState(character, config.env.simulation,
-                                            first_camera, {root_px, scale_px});
   const int root = character->root_qpos_address();
-  int succeeded = 0;
-  double e2d_sum_px = 0.0;
+  const std::vector<double> azimuths_deg =
+      args.azimuths_deg.empty() ? std::vector<double>{args.view[0]}
+                                : args.azimuths_deg;
   std::printf(
-      "tracking with %s: %d generation(s) x %.0f s, view %.0f,%.0f,%.1f\n",
-      args.policy.c_str(), args.generations, args.seconds, args.view[0],
+      "tracking with %s: %d generation(s) x %.0f s x %zu view(s) (elevation "
+      "%.0f deg, %.1f m)\n",
+      args.policy.c_str(), args.generations, args.seconds, azimuths_deg.size(),
       args.view[1], args.view[2]);
-  for (int g = 0; g < args.generations; ++g) {
-    GeneratedStreamOptions stream_options;
-    stream_options.sampling = {args.temperature, args.top_k};
-    stream_options.seed = args.seed + g;
-    stream_options.first_root_px = root_px;
-    stream_options.first_scale_px = scale_px;
-    stream_options.image_width_px = first_camera.intrinsics().width_px;
-    stream_options.image_height_px = first_camera.intrinsics().height_px;
-    GeneratedStream stream(args.run_dir, stream_options);
-    StreamedRollout rollout(
-        character, env_options, &stream,
-        [&](int, const SimState& state) {
-          return first_camera.Translated(
-              {state.qpos[root] - start.qpos[root],
-               state.qpos[root + 1] - start.qpos[root + 1], 0.0});
-        },
-        start);
-    std::vector<EpisodeFrame> frames;
-    auto record = [&] {
-      if (g != 0 || args.video.empty()) return;
-      EpisodeFrame frame;
-      frame.clip_frame = rollout.frame();
-      frame.camera = rollout.camera();
-      frame.reference = rollout.reference_frame();
-      frame.state = rollout.simulation().Save();
-      frames.push_back(std::move(frame));
-    };
-    record();
-    const auto started = std::chrono::steady_clock::now();
-    while (rollout.Step(policy)) record();
-    record();
-    const double wall_s = std::chrono::duration<double>(
-                              std::chrono::steady_clock::now() - started)
-                              .count();
-    const EpisodeStats& stats = rollout.stats();
-    succeeded += stats.failed ? 0 : 1;
-    e2d_sum_px += stats.mean_error_px();
-    std::printf(
-        "  generation %d (seed %llu): %s after %d of %d frames, E2D %.1f px, "
-        "%.0fx real time\n",
-        g + 1, static_cast<unsigned long long>(stream_options.seed),
-        stats.failed ? "lost (early exit)" : "tracked to the end", stats.steps,
-        env_options.max_episode_steps(), stats.mean_error_px(),
-        stats.steps / config.env.simulation.control_hz /
-            std::max(1e-9, wall_s));
-    std::fflush(stdout);
-    if (!frames.empty()) {
+  int succeeded = 0, rollouts = 0;
+  double e2d_sum_px = 0.0;
+  for (double azimuth_deg : azimuths_deg) {
+    const PinholeCamera first_camera = ViewCamera(args, azimuth_deg);
+    Eigen::Vector2d root_px;
+    double scale_px = 0.0;
+    StandingPlacement(first_camera, &root_px, &scale_px);
+    const SimState start = PlacedDefaultState(
+        character, config.env.simulation, first_camera, {root_px, scale_px});
+    for (int g = 0; g < args.generations; ++g) {
+      GeneratedStreamOptions stream_options;
+      stream_options.sampling = {args.temperature, args.top_k};
+      stream_options.seed = args.seed + g;
+      stream_options.first_root_px = root_px;
+      stream_options.first_scale_px = scale_px;
+      stream_options.image_width_px = first_camera.intrinsics().width_px;
+      stream_options.image_height_px = first_camera.intrinsics().height_px;
+      GeneratedStream stream(args.run_dir, stream_options);
+      StreamedRollout rollout(
+          character, env_options, &stream,
+          [&](int, const SimState& state) {
+            return first_camera.Translated(
+                {state.qpos[root] - start.qpos[root],
+                 state.qpos[root + 1] - start.qpos[root + 1], 0.0});
+          },
+          start);
+      const bool draw = rollouts == 0 && !args.video.empty();
+      std::vector<EpisodeFrame> frames;
+      auto record = [&] {
+        if (!draw) return;
+        EpisodeFrame frame;
+        frame.clip_frame = rollout.frame();
+        frame.camera = rollout.camera();
+        frame.reference = rollout.reference_frame();
+        frame.state = rollout.simulation().Save();
+        frames.push_back(std::move(frame));
+      };
+      record();
+      const auto started = std::chrono::steady_clock::now();
+      while (rollout.Step(policy)) record();
+      record();
+      const double wall_s = std::chrono::duration<double>(
+                                std::chrono::steady_clock::now() - started)
+                                .count();
+      const EpisodeStats& stats = rollout.stats();
+      ++rollouts;
+      succeeded += stats.failed ? 0 : 1;
+      e2d_sum_px += stats.mean_error_px();
+      std::printf(
+          "  azimuth %.0f deg, generation %d (seed %llu): %s after %d of %d "
+          "frames, E2D %.1f px, %.0fx real time\n",
+          azimuth_deg, g + 1,
+          static_cast<unsigned long long>(stream_options.seed),
+          stats.failed ? "lost (early exit)" : "tracked to the end",
+          stats.steps, env_options.max_episode_steps(), stats.mean_error_px(),
+          stats.steps / config.env.simulation.control_hz /
+              std::max(1e-9, wall_s));
+      std::fflush(stdout);
+      if (!draw) continue;
       RecordedFrames recorded(std::move(frames));
-      Clip2D format = stream.format();
+      const Clip2D& format = stream.format();
       BundleReplayOptions replay;
       replay.output.video_path = args.video;
       EpisodeRenderOptions render;
@@ -250,17 +261,18 @@ int RunTrackedGenerations(const GenerateArgs& args, Eigen::Vector2d root_px,
                   summary.frames_rendered);
     }
   }
-  std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px\n", succeeded,
-              args.generations, 100.0 * succeeded / args.generations,
-              e2d_sum_px / args.generations);
+  std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px\n", succeeded, rollouts,
+              100.0 * succeeded / rollouts, e2d_sum_px / rollouts);
   return 0;
 }
 
 int RunGenerate(const GenerateArgs& args) {
   if (args.view.size() != 3)
     throw ConfigError("generate: --view takes azimuth,elevation,distance");
-  if (args.policy.empty() && (!args.video.empty() || args.generations != 1))
-    throw ConfigError("generate: --video and --generations need --policy");
+  if (args.policy.empty() && (!args.video.empty() || args.generations != 1 ||
+                              !args.azimuths_deg.empty()))
+    throw ConfigError(
+        "generate: --video, --generations and --azimuths need --policy");
   SamplingOptions sampling;
   sampling.temperature = args.temperature;
   sampling.top_k = args.top_k;
@@ -271,7 +283,7 @@ int RunGenerate(const GenerateArgs& args) {
 
   Eigen::Vector2d root_px;
   double scale_px = 0.0;
-  StandingPlacement(args, &root_px, &scale_px);
+  StandingPlacement(ViewCamera(args, args.view[0]), &root_px, &scale_px);
   Clip2D clip = FromCanonical(CanonicalFromFeatures(
       motion.rows.data(), frames, Coco17Layout(), fps, root_px, scale_px));
   WriteClip(args.output, clip);
@@ -281,7 +293,7 @@ int RunGenerate(const GenerateArgs& args) {
       args.output.c_str(), frames, fps, frames / fps, motion.num_codes,
       motion.generation_s, frames / fps / std::max(1e-9, motion.generation_s));
   if (args.policy.empty()) return 0;
-  return RunTrackedGenerations(args, root_px, scale_px);
+  return RunTrackedGenerations(args);
 }
 
 struct GenEvalArgs {
@@ -437,6 +449,12 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->add_option("--generations", generate_args->generations,
                    "With --policy: streams to track (seeds seed, seed+1, ...)")
       ->check(CLI::Range(1, 10000));
+  generate
+      ->add_option("--azimuths", generate_args->azimuths_deg,
+                   "With --policy: camera azimuths (deg) to track each stream "
+                   "from, at --view's elevation and distance (default: "
+                   "--view's azimuth)")
+      ->delimiter(',');
   generate->add_option("--video", generate_args->video,
                        "With --policy: the first tracked stream drawn (MP4)");
   generate->callback([run, generate_args] {

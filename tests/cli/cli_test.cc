@@ -95,12 +95,14 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   const std::string policy =
       testing::SourcePath("assets/policies/walk2d/checkpoint.pt");
   result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
-                      policy + " --generations 2 --video " + dir +
-                      "/tracked.mp4 -o " + dir + "/generated.json");
+                      policy + " --generations 2 --azimuths 30,120 --video " +
+                      dir + "/tracked.mp4 -o " + dir + "/generated.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_NE(result.output.find("generation 2 (seed 2): "), std::string::npos)
+  EXPECT_NE(result.output.find("azimuth 120 deg, generation 2 (seed 2): "),
+            std::string::npos)
       << result.output;
   EXPECT_NE(result.output.find("Succ "), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("/4 ("), std::string::npos) << result.output;
   EXPECT_GT(std::filesystem::file_size(dir + "/tracked.mp4"), 1000u);
   EXPECT_EQ(ReadClip(dir + "/generated.json").num_frames(), 60);
   // The tracking options need a tracker.
