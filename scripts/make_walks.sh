@@ -1,0 +1,44 @@
+#!/bin/bash
+# The walk family for the generator's tracker (issue 16, docs/generation.md
+# "The tracker fed by the stream"): the long DeepMimic walks the generator
+# learns from (configs/gen/walks.yaml), each seen by 4 cameras that follow
+# the walker (elevation 10 deg, 4.5 m, focal 1000 px, as the walk2d
+# policy's bundle), stripped to their 2D and fitted view by view with the
+# focal known: a user's four following videos per walk.
+#
+#   scripts/make_walks.sh [OUT_DIR] [WALK...]   (default runs/walks, all nine)
+#
+# Writes OUT_DIR/<walk>_truth.json (the measurement's side), <walk>_2d.json
+# (stripped) and <walk>.json (the fit's estimate: what training reads).
+# Walks come from $MIMIC2D_SHARED_DATA (default ../shared/data)/deepmimic/
+# motions/long; they stay there (MIT, but not carried by the repository).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-runs/walks}
+shift || true
+shared=${MIMIC2D_SHARED_DATA:-../shared/data}
+long="$shared/deepmimic/motions/long"
+bin=build/mimic2d
+mkdir -p "$out"
+walks=("$@")
+if [ ${#walks[@]} -eq 0 ]; then
+  walks=(long_walk1 long_walk1_mirror long_walk2 long_walk2_mirror long_walk3
+         long_walk3_mirror long_zombie stealthy_walk0 stealthy_walk1)
+fi
+
+for walk in "${walks[@]}"; do
+  motion="$long/humanoid3d_$walk.txt"
+  [ -f "$motion" ] || { echo "make_walks: $motion not found" >&2; exit 1; }
+  [ -f "$out/$walk.json" ] && { echo "kept $out/$walk.json"; continue; }
+  $bin clip from-motion "$motion" --views 4 --elevation 10 --distance 4.5 \
+    --focal 1000 --follow -o "$out/${walk}_truth.json" > /dev/null
+  $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
+    > /dev/null
+  if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \
+    --threads 2 --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
+  then
+    echo "fitted $walk: $(grep -c 'all frames converged' "$out/${walk}_fit.log") of 4 views converged on every frame"
+  else
+    echo "left out $walk: $(tail -n 1 "$out/${walk}_fit.log")"
+  fi
+done
