@@ -76,8 +76,9 @@ bool StreamedRollout::FillWindow() {
 
 void StreamedRollout::Restart(const SimState& state) {
   // Outline: the window as a one-view bundle with per-frame cameras,
-  // prepared as any reference is (cameras: truth, the bundle's own), then a
-  // TrackingEnv on it, reset to the window's first frame at `state`.
+  // prepared as any reference is (cameras: truth, the bundle's own), then
+  // the TrackingEnv moved onto it (made once), reset to the window's first
+  // frame at `state`.
   const Clip2D& format = stream_->format();
   ReferenceBundle bundle;
   bundle.name = "stream";
@@ -103,8 +104,12 @@ void StreamedRollout::Restart(const SimState& state) {
   auto reference =
       TrackingReference::Prepare({std::move(bundle)}, *character_,
                                  options_.simulation.control_hz, sources);
-  env_ = std::make_unique<TrackingEnv>(character_, std::move(reference),
-                                       nullptr, options_, 0);
+  if (env_ == nullptr) {
+    env_ = std::make_unique<TrackingEnv>(character_, std::move(reference),
+                                         nullptr, options_, 0);
+  } else {
+    env_->Rebase(std::move(reference));
+  }
   observation_.resize(env_->observation_size());
   env_->ResetTo(0, 0, state, observation_.data());
 }

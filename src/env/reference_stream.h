@@ -50,13 +50,13 @@ using StreamCamera =
 
 // One tracker rollout along a stream. Each control step prepares the
 // frames it observes (the current one and the L future ones) as a
-// one-view reference with their cameras, restarts a TrackingEnv on it from
-// the simulation's current state, and steps it; observation, reward and
-// early exit are the environment's own, so a recorded clip streamed this way
-// rolls out exactly as the same clip prepared whole (tested). The camera of
-// each frame is asked for when the frame enters the window, so a camera that
-// follows the character lags it by up to L frames. Object tracks are not
-// streamed.
+// one-view reference with their cameras, moves its TrackingEnv onto it
+// (Rebase), restarts it from the simulation's current state, and steps it;
+// observation, reward and early exit are the environment's own, so a recorded
+// clip streamed this way rolls out exactly as the same clip prepared whole
+// (tested). The camera of each frame is asked for when the frame enters the
+// window, so a camera that follows the character lags it by up to L frames.
+// Object tracks are not streamed.
 class StreamedRollout {
  public:
   // `options.max_episode_s` and `options.early_exit` apply as in training;
@@ -88,7 +88,7 @@ class StreamedRollout {
   // Reads frames until the window [frame_, frame_ + L] is full or the
   // stream ends; false when not even frame_ + 1 exists.
   bool FillWindow();
-  // A TrackingEnv on the window, started from `state`.
+  // The TrackingEnv on the window, started from `state`.
   void Restart(const SimState& state);
 
   std::shared_ptr<const Character> character_;

@@ -59,6 +59,17 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   object_velocities_.resize(layout_.num_objects);
 }
 
+void TrackingEnv::Rebase(std::shared_ptr<const TrackingReference> reference) {
+  if (reference->num_points() != reference_->num_points() ||
+      reference->object_bodies() != reference_->object_bodies()) {
+    throw ConfigError(
+        "env: a new reference must keep the points and objects tracked");
+  }
+  reference_ = std::move(reference);
+  std::fill(observed_views_.begin(), observed_views_.end(), nullptr);
+  view_ = nullptr;
+}
+
 void TrackingEnv::Reset(float* observation) {
   // Outline: pick a view uniformly, a start frame uniformly (leaving at
   // least one step), an initial state from that frame's buffer.

@@ -145,6 +145,11 @@ class TrackingEnv {
   // worst keypoint is off, and the error and reward are the views' means.
   void ResetToViews(const std::vector<int>& view_indices, int frame,
                     const SimState& state, float* observation);
+  // Tracks `reference` from now on (the next ResetTo picks a view of it),
+  // keeping the simulation: for a reference that arrives piecewise
+  // (env/reference_stream.h). Its points per frame and objects must be the
+  // current one's (the observation layout); ConfigError otherwise.
+  void Rebase(std::shared_ptr<const TrackingReference> reference);
   // Advances one control period. Writes the next observation unless the
   // episode ended (the caller resets).
   StepOutcome Step(const float* action, float* observation);
