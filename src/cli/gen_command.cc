@@ -185,7 +185,9 @@ int RunTrackedGenerations(const GenerateArgs& args) {
                                 : args.azimuths_deg;
   std::printf(
       "tracking with %s: %d generation(s) x %.0f s x %zu view(s) (elevation "
-      "%.0f deg, %.1f m)\n",
+      "%.0f deg, %.1f m)\nstarts from the default pose placed under the "
+      "first generated frame (no 3D), cameras the chosen view dollying with "
+      "the character\n",
       args.policy.c_str(), args.generations, args.seconds, azimuths_deg.size(),
       args.view[1], args.view[2]);
   int succeeded = 0, rollouts = 0;

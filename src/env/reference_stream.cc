@@ -45,8 +45,6 @@ StreamedRollout::StreamedRollout(std::shared_ptr<const Character> character,
     throw InputError("reference stream", "needs at least 2 frames");
   }
   Restart(state_);
-  observation_.resize(env_->observation_size());
-  action_.resize(env_->action_size());
 }
 
 bool StreamedRollout::FillWindow() {
@@ -107,10 +105,11 @@ void StreamedRollout::Restart(const SimState& state) {
   if (env_ == nullptr) {
     env_ = std::make_unique<TrackingEnv>(character_, std::move(reference),
                                          nullptr, options_, 0);
+    observation_.resize(env_->observation_size());
+    action_.resize(env_->action_size());
   } else {
     env_->Rebase(std::move(reference));
   }
-  observation_.resize(env_->observation_size());
   env_->ResetTo(0, 0, state, observation_.data());
 }
 

@@ -70,18 +70,13 @@ class StreamedRollout {
   // a divergence), after which it does nothing.
   bool Step(Policy& policy);
 
-  bool ended() const { return ended_; }
   int frame() const { return frame_; }  // the stream frame tracked now
   // The rollout's counts over the whole stream (view_index and
   // start_frame 0).
   const EpisodeStats& stats() const { return stats_; }
   const Simulation& simulation() const { return env_->simulation(); }
-  // The current frame's reference keypoints and the simulated ones
-  // projected by its camera (x, y per keypoint), for drawing.
+  // The current frame's reference keypoints and camera, for drawing.
   const std::vector<Keypoint2D>& reference_frame() const;
-  const std::vector<double>& projected_px() const {
-    return env_->projected_px();
-  }
   const PinholeCamera& camera() const { return cameras_.front(); }
 
  private:

@@ -1080,12 +1080,11 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   // down on an upright body and a level one on a body leaning toward it
   // project almost alike, and a local solve from level does not cross
   // between the two.
-  const double facing_deg = best_turn_deg;
   for (size_t p = 1; p < options.pitch_starts_deg.size(); ++p) {
     char name[64];
     std::snprintf(name, sizeof(name), "pitch start %zu/%zu (%.0f deg)", p + 1,
                   options.pitch_starts_deg.size(), options.pitch_starts_deg[p]);
-    try_start(facing_deg, options.pitch_starts_deg[p], name);
+    try_start(best_turn_deg, options.pitch_starts_deg[p], name);
   }
   char label[96];
   std::snprintf(label, sizeof(label),

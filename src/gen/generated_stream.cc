@@ -33,25 +33,24 @@ GeneratedStream::~GeneratedStream() = default;
 
 bool GeneratedStream::Next(std::vector<Keypoint2D>* keypoints) {
   // Outline: draw the next code's frames when those decoded are used up;
-  // then one frame from its local pose and steps, the running root and
-  // scale advanced as FromCanonical does.
+  // then one frame as a one-frame clip placed at the running root and scale
+  // (CanonicalFromFeatures applies its steps on top of them, as
+  // FromCanonical does for a clip's later frames), which become its own.
   const KeypointLayout& layout = *format_.layout;
-  const int num_keypoints = layout.num_keypoints();
   const size_t frame_size = CanonicalFrameSize(layout);
   if (next_row_ * frame_size >= rows_.size()) {
     rows_.clear();
     next_row_ = 0;
     stream_->Next(&rows_);
   }
-  const float* row = rows_.data() + next_row_++ * frame_size;
-  std::vector<Keypoint2D> local(num_keypoints);
-  for (int j = 0; j < num_keypoints; ++j)
-    local[j] = {row[2 * j], row[2 * j + 1], 1.0};
-  keypoints->resize(num_keypoints);
-  CanonicalFrameToAbsolute(
-      local.data(), num_keypoints,
-      Eigen::Vector2d(row[2 * num_keypoints], row[2 * num_keypoints + 1]),
-      row[2 * num_keypoints + 2], &root_px_, &scale_px_, keypoints->data());
+  const CanonicalClip frame =
+      CanonicalFromFeatures(rows_.data() + next_row_++ * frame_size, 1, layout,
+                            format_.fps, root_px_, scale_px_);
+  root_px_ = frame.first_root_px;
+  scale_px_ = frame.first_scale_px;
+  const Clip2D absolute = FromCanonical(frame);
+  const Keypoint2D* points = absolute.keypoints.frame(0);
+  keypoints->assign(points, points + layout.num_keypoints());
   return true;
 }
 

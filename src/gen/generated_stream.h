@@ -46,7 +46,7 @@ class GeneratedStream : public ReferenceStream {
   Clip2D format_;
   std::vector<float> rows_;  // X^can frames decoded, not yet handed out
   size_t next_row_ = 0;
-  Eigen::Vector2d root_px_;
+  Eigen::Vector2d root_px_;  // the last frame's root and scale
   double scale_px_;
 };
 

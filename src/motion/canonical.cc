@@ -129,16 +129,6 @@ CanonicalClip ToCanonical(const Clip2D& clip, const std::string& source) {
   return canonical;
 }
 
-void CanonicalFrameToAbsolute(const Keypoint2D* local_pose, int num_keypoints,
-                              const Eigen::Vector2d& delta_root,
-                              double delta_log_scale, Eigen::Vector2d* root,
-                              double* scale, Keypoint2D* keypoints) {
-  *scale *= std::exp(delta_log_scale);
-  *root += *scale * delta_root;
-  for (int j = 0; j < num_keypoints; ++j)
-    keypoints[j] = FromLocal(local_pose[j], *root, *scale);
-}
-
 Clip2D FromCanonical(const CanonicalClip& canonical) {
   CheckCanonicalShapes(canonical);
   Clip2D clip;
@@ -151,15 +141,16 @@ Clip2D FromCanonical(const CanonicalClip& canonical) {
   clip.keypoints = KeypointTrack(num_frames, num_keypoints);
   Eigen::Vector2d root = canonical.first_root_px;
   double scale = canonical.first_scale_px;
-  std::vector<Keypoint2D> frame(num_keypoints);
   for (int t = 0; t < num_frames; ++t) {
-    // Frame 0 sits at the first root and scale: its steps are not applied.
-    CanonicalFrameToAbsolute(
-        canonical.local_pose.frame(t), num_keypoints,
-        t > 0 ? canonical.delta_root[t] : Eigen::Vector2d::Zero(),
-        t > 0 ? canonical.delta_log_scale[t] : 0.0, &root, &scale,
-        frame.data());
-    for (int j = 0; j < num_keypoints; ++j) clip.keypoints.at(t, j) = frame[j];
+    if (t > 0) {
+      // s_t first: the root step is normalised by the current scale.
+      scale *= std::exp(canonical.delta_log_scale[t]);
+      root += scale * canonical.delta_root[t];
+    }
+    for (int j = 0; j < num_keypoints; ++j) {
+      clip.keypoints.at(t, j) =
+          FromLocal(canonical.local_pose.at(t, j), root, scale);
+    }
   }
   return clip;
 }

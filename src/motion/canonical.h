@@ -57,14 +57,6 @@ struct CanonicalClip {
 // (naming `source`) when no frame has a root and scale.
 CanonicalClip ToCanonical(const Clip2D& clip, const std::string& source = "");
 
-// One frame of G⁻¹ for a stream: advances the running `root` and `scale` by
-// the frame's steps (the scale first: the root step is normalised by the
-// current scale) and writes its `num_keypoints` absolute keypoints.
-void CanonicalFrameToAbsolute(const Keypoint2D* local_pose, int num_keypoints,
-                              const Eigen::Vector2d& delta_root,
-                              double delta_log_scale, Eigen::Vector2d* root,
-                              double* scale, Keypoint2D* keypoints);
-
 // G⁻¹(X^can): the exact inverse of ToCanonical for the keypoints (up to
 // floating-point rounding). Throws InputError on inconsistent sizes or a
 // non-positive first scale.
