@@ -92,10 +92,11 @@ int RunGenTrain(const GenTrainArgs& args) {
           p.learning_rate, p.step / std::max(1e-9, p.seconds), eta_s);
     } else {
       std::printf(
-          "prior     %7lld/%lld | cross-entropy %.4f nats | next-code "
-          "accuracy %5.1f%% | lr %.1e | %.1f steps/s | ETA %.0f s\n",
+          "prior     %7lld/%lld | cross-entropy %.4f nats (held out %.4f) | "
+          "next-code accuracy %5.1f%% | lr %.1e | %.1f steps/s | ETA %.0f "
+          "s\n",
           static_cast<long long>(p.step), static_cast<long long>(p.steps),
-          p.loss, 100.0 * p.accuracy, p.learning_rate,
+          p.loss, p.validation_loss, 100.0 * p.accuracy, p.learning_rate,
           p.step / std::max(1e-9, p.seconds), eta_s);
     }
     std::fflush(stdout);
@@ -331,7 +332,8 @@ int RunGenEval(const GenEvalArgs& args) {
         {"top_k", args.options.sampling.top_k},
         {"held_apart", args.held_apart},
         {"fid", result.fid},
-        {"fid_floor", result.fid_floor},
+        {"fid_floor_time", result.fid_floor_time},
+        {"fid_floor_views", result.fid_floor_views},
         {"fid_reconstruction", result.fid_reconstruction},
         {"reconstruction_pose_error", result.reconstruction_pose_error},
         {"reconstruction_root_error", result.reconstruction_root_error},

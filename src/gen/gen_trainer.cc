@@ -318,15 +318,20 @@ double TrainPrior(const StageContext& context, bool resume,
       generator.set_state(state->generator_state);
   }
   StageLog log(context.RunFile("prior_log.csv"),
-               "step,seconds,learning_rate,cross_entropy,accuracy", resume,
-               state->step);
+               "step,seconds,learning_rate,cross_entropy,accuracy,"
+               "validation_cross_entropy",
+               resume, state->step);
+  // The last context of codes of every long sequence is held out: how far
+  // the prior generalizes beyond memorizing the sequences it reads.
+  const TokenSplit split =
+      SplitTokensForValidation(token_sequences, options.context_tokens);
   TokenBatch batch;
   torch::Tensor logits, loss;
   model->train();
   // One step: a batch of (corrupted) token windows, next-token
   // cross-entropy, AdamW with the gradient norm clipped at 1.
   auto step = [&] {
-    batch = SampleTokenBatch(token_sequences, model->num_codes(),
+    batch = SampleTokenBatch(split.training, model->num_codes(),
                              options.context_tokens, options.batch_size,
                              options.keep_probability, generator);
     logits = model->forward(batch.inputs);
@@ -346,10 +351,18 @@ double TrainPrior(const StageContext& context, bool resume,
                       .sum()
                       .item<double>() /
                   std::max<double>(1.0, counted.sum().item<double>());
+    if (split.validation.inputs.defined()) {
+      model->eval();  // no dropout
+      p->validation_loss =
+          NextTokenLoss(model->forward(split.validation.inputs),
+                        split.validation.targets)
+              .item<double>();
+      model->train();
+    }
     char row[256];
-    std::snprintf(row, sizeof(row), "%lld,%.2f,%.3g,%.6g,%.4f",
+    std::snprintf(row, sizeof(row), "%lld,%.2f,%.3g,%.6g,%.4f,%.6g",
                   static_cast<long long>(p->step), p->seconds, p->learning_rate,
-                  p->loss, p->accuracy);
+                  p->loss, p->accuracy, p->validation_loss);
     return std::string(row);
   };
   auto save = [&] {

@@ -31,8 +31,11 @@ struct GenProgress {
          commit_loss = 0.0;
   double perplexity = 0.0;
   int used_codes = 0, reset_codes = 0;
-  // Prior: share of next tokens predicted exactly (argmax).
+  // Prior: share of next tokens predicted exactly (argmax), and the
+  // cross-entropy on the held-out tail of every sequence (NaN when no
+  // sequence is long enough to keep one; gpt.h's SplitTokensForValidation).
   double accuracy = 0.0;
+  double validation_loss = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct GenTrainSummary {

@@ -64,9 +64,11 @@ GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
 std::string GeneratorEvalResult::BriefReport() const {
   std::ostringstream out;
   out.precision(4);
-  out << "FID generated vs real " << fid
-      << " (floor, real vs real: " << fid_floor << ", ratio "
-      << (fid_floor > 0 ? fid / fid_floor : 0.0) << ")\n"
+  auto ratio = [&](double floor) { return floor > 0 ? fid / floor : 0.0; };
+  out << "FID generated vs real " << fid << "; floors, real vs real: halves "
+      << "in time " << fid_floor_time << " (ratio " << ratio(fid_floor_time)
+      << "), halves by view " << fid_floor_views << " (ratio "
+      << ratio(fid_floor_views) << ")\n"
       << "FID of the tokenizer's reconstructions vs real " << fid_reconstruction
       << "; mean |error|: local pose " << reconstruction_pose_error
       << ", root step " << reconstruction_root_error << ", log-scale step "
@@ -104,16 +106,28 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       TrainFeatureEncoder(held_windows, frame_size, encoder_options,
                           options.seed, &result.encoder_loss);
 
-  // 2. Real features, and the floor: two halves of the real sequences.
+  // 2. Real features, and the floors: the real sequences in two halves by
+  // view, and in two halves in time.
   const torch::Tensor real_windows = windows_of(real.sequences);
   result.real_windows = static_cast<int>(real_windows.size(0));
   const Eigen::MatrixXd real_features = EncodeWindows(encoder, real_windows);
-  std::vector<GenSequence> half[2];
-  for (size_t i = 0; i < real.sequences.size(); ++i)
-    half[i % 2].push_back(real.sequences[i]);
-  result.fid_floor = FrechetDistance(
-      FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[0]))),
-      FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[1]))));
+  auto halves_fid = [&](const std::vector<GenSequence>(&half)[2]) {
+    return FrechetDistance(
+        FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[0]))),
+        FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[1]))));
+  };
+  {
+    std::vector<GenSequence> by_view[2], by_time[2];
+    for (size_t i = 0; i < real.sequences.size(); ++i)
+      by_view[i % 2].push_back(real.sequences[i]);
+    for (const GenSequence& sequence : real.sequences) {
+      const auto [first, second] = SplitSequenceInTime(sequence, frame_size);
+      by_time[0].push_back(first);
+      by_time[1].push_back(second);
+    }
+    result.fid_floor_views = halves_fid(by_view);
+    result.fid_floor_time = halves_fid(by_time);
+  }
 
   // The tokenizer alone: every real window encoded and decoded (windows
   // of the length it was trained on; decoding whole sequences at once was

@@ -52,7 +52,12 @@ struct GeneratorEvalResult {
   // Its mean |error| per channel group of X^can (body-scale units).
   double reconstruction_pose_error = 0.0, reconstruction_root_error = 0.0,
          reconstruction_scale_error = 0.0;
-  double fid_floor = 0.0;       // real vs real: two halves of the sequences
+  // Real vs real, two floors: the sequences' views in two halves
+  // (alternating; every motion and frame in both: how far the features
+  // move with the view alone) and every sequence cut in two in time (every
+  // motion and view in both, no frame in both: real motion that is not the
+  // same motion, the floor a generator of new motion is held to).
+  double fid_floor_views = 0.0, fid_floor_time = 0.0;
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;
   double realtime_factor = 0.0;  // generated seconds per second of CPU
@@ -63,8 +68,8 @@ struct GeneratorEvalResult {
 // Outline: the real windows (the generator's own dataset, rebuilt from its
 // config) and the held-apart windows (`held_apart`: motions it never saw)
 // in the tokenizer's normalization; an encoder trained on the held-apart
-// windows; features of the real windows, of two halves of them (by
-// sequence, alternating) and of `generations` generated streams; FIDs and
+// windows; features of the real windows, of two pairs of halves of them
+// (by view and by time) and of `generations` generated streams; FIDs and
 // diversities. `run_dir` holds tokenizer.pt and prior.pt.
 GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                                       const GenDataset& real,

@@ -180,6 +180,34 @@ TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
   return {inputs, targets};
 }
 
+TokenSplit SplitTokensForValidation(
+    const std::vector<std::vector<int64_t>>& sequences, int context) {
+  TokenSplit split;
+  std::vector<torch::Tensor> inputs, targets;
+  for (const std::vector<int64_t>& codes : sequences) {
+    const int64_t n = static_cast<int64_t>(codes.size());
+    if (n < 2 * context + 1) {
+      split.training.push_back(codes);
+      continue;
+    }
+    split.training.emplace_back(codes.begin(), codes.end() - context);
+    const int64_t* data = codes.data();
+    inputs.push_back(
+        torch::from_blob(const_cast<int64_t*>(data + n - context - 1),
+                         {context}, torch::kLong)
+            .clone());
+    targets.push_back(torch::from_blob(const_cast<int64_t*>(data + n - context),
+                                       {context}, torch::kLong)
+                          .clone());
+    split.held_out_codes += context;
+  }
+  if (!inputs.empty()) {
+    split.validation.inputs = torch::stack(inputs);
+    split.validation.targets = torch::stack(targets);
+  }
+  return split;
+}
+
 torch::Tensor NextTokenLoss(const torch::Tensor& logits,
                             const torch::Tensor& targets) {
   return F::cross_entropy(

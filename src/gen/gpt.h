@@ -91,6 +91,21 @@ TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
                             double keep_probability,
                             torch::Generator& generator);
 
+// The prior's held-out data: every sequence long enough (at least
+// 2 * context + 1 codes) keeps its last `context` codes apart. `validation`
+// holds one window per such sequence whose targets are exactly those codes
+// (inputs: the code before them and all but the last of them; undefined
+// tensors when no sequence is long enough); `training` is every sequence
+// without its held-out codes, so no held-out code is ever an input or a
+// target of training.
+struct TokenSplit {
+  std::vector<std::vector<int64_t>> training;
+  TokenBatch validation;
+  int held_out_codes = 0;
+};
+TokenSplit SplitTokensForValidation(
+    const std::vector<std::vector<int64_t>>& sequences, int context);
+
 // Mean next-token cross-entropy (nats) of a batch.
 torch::Tensor NextTokenLoss(const torch::Tensor& logits,
                             const torch::Tensor& targets);

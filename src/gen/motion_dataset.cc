@@ -105,6 +105,20 @@ int64_t GenDataset::num_frames() const {
   return frames;
 }
 
+std::pair<GenSequence, GenSequence> SplitSequenceInTime(
+    const GenSequence& sequence, int frame_size) {
+  const int first_frames = sequence.num_frames / 2;
+  const auto middle = sequence.features.begin() +
+                      static_cast<size_t>(first_frames) * frame_size;
+  GenSequence first{sequence.name + "/first",
+                    first_frames,
+                    {sequence.features.begin(), middle}};
+  GenSequence second{sequence.name + "/second",
+                     sequence.num_frames - first_frames,
+                     {middle, sequence.features.end()}};
+  return {std::move(first), std::move(second)};
+}
+
 void FeatureStatistics(const std::vector<GenSequence>& sequences,
                        int frame_size, std::vector<float>* mean,
                        std::vector<float>* std) {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camera/rig.h"
@@ -89,6 +90,11 @@ inline constexpr float kMinFeatureStd = 1e-3f;
 GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
                            const GenViewOptions& views, double fps,
                            double loop_to_s);
+
+// `sequence` cut at its middle frame into its first and second half
+// ("<name>/first", "<name>/second"; rows as they are).
+std::pair<GenSequence, GenSequence> SplitSequenceInTime(
+    const GenSequence& sequence, int frame_size);
 
 // Per-channel mean and std (floored) of every row of `sequences`.
 void FeatureStatistics(const std::vector<GenSequence>& sequences,

@@ -171,7 +171,8 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_EQ(result.generated_windows, 2 * ((90 - 16) / 8 + 1));
   EXPECT_GT(result.real_windows, 0);
   EXPECT_GE(result.fid, 0.0);
-  EXPECT_GE(result.fid_floor, 0.0);
+  EXPECT_GE(result.fid_floor_views, 0.0);
+  EXPECT_GE(result.fid_floor_time, 0.0);
   EXPECT_GT(result.diversity_generated, 0.0);
   EXPECT_GT(result.realtime_factor, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));

@@ -121,5 +121,27 @@ TEST(Gpt, LearnsACycleAndContinuesItEndlessly) {
     EXPECT_EQ(codes[i], (codes[i - 1] + 1) % 6) << "at " << i;
 }
 
+TEST(Gpt, HeldOutCodesAreNeverTrainedOn) {
+  const int context = 4;
+  std::vector<std::vector<int64_t>> sequences = {
+      {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11},  // 12 >= 2 * 4 + 1: split
+      {20, 21, 22}};                           // too short: kept whole
+  const TokenSplit split = SplitTokensForValidation(sequences, context);
+  ASSERT_EQ(split.training.size(), 2u);
+  EXPECT_EQ(split.training[0], (std::vector<int64_t>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(split.training[1], sequences[1]);
+  EXPECT_EQ(split.held_out_codes, context);
+  ASSERT_TRUE(split.validation.inputs.defined());
+  ASSERT_EQ(split.validation.inputs.sizes(), (std::vector<int64_t>{1, 4}));
+  // Targets are the last 4 codes; inputs the code before them onward.
+  EXPECT_TRUE(split.validation.targets[0].equal(
+      torch::tensor({8, 9, 10, 11}, torch::kLong)));
+  EXPECT_TRUE(split.validation.inputs[0].equal(
+      torch::tensor({7, 8, 9, 10}, torch::kLong)));
+  // Nothing long enough: no validation batch.
+  EXPECT_FALSE(SplitTokensForValidation({{1, 2, 3}}, context)
+                   .validation.inputs.defined());
+}
+
 }  // namespace
 }  // namespace m2d

@@ -93,5 +93,22 @@ TEST(GenDataset, RejectsViewsThatCannotBe) {
   EXPECT_THROW(views.Validate(), ConfigError);
 }
 
+TEST(GenDataset, ASequenceSplitInTimeKeepsEveryRowOnce) {
+  const int frame_size = 3;
+  GenSequence sequence{"walk/0", 5, {}};
+  for (int i = 0; i < 5 * frame_size; ++i)
+    sequence.features.push_back(static_cast<float>(i));
+  const auto [first, second] = SplitSequenceInTime(sequence, frame_size);
+  EXPECT_EQ(first.name, "walk/0/first");
+  EXPECT_EQ(second.name, "walk/0/second");
+  ASSERT_EQ(first.num_frames, 2);
+  ASSERT_EQ(second.num_frames, 3);
+  ASSERT_EQ(first.features.size(), 2u * frame_size);
+  ASSERT_EQ(second.features.size(), 3u * frame_size);
+  EXPECT_EQ(first.features.front(), 0.0f);
+  EXPECT_EQ(second.features.front(), 6.0f);  // row 2
+  EXPECT_EQ(second.features.back(), 14.0f);
+}
+
 }  // namespace
 }  // namespace m2d
