@@ -236,6 +236,10 @@ struct RunOptions {
   int64_t total_samples = 20'000'000;  // stop after this many env steps
   double checkpoint_minutes = 5.0;     // periodic atomic checkpoint
   int env_threads = 2;                 // OpenMP threads stepping envs
+  // A fresh run's networks (and observation normalizer) start from this
+  // checkpoint's: fine-tuning a trained policy on new references. Empty:
+  // random weights. Ignored when resuming the run's own checkpoint.
+  std::string init_from;
 
   // Every setting (common/settings.h): the config's `run` section.
   template <typename Self, typename Visitor>
@@ -249,6 +253,11 @@ struct RunOptions {
       "period of the atomic checkpoint (minutes)");
     v("env_threads", self.env_threads, Range::Closed(1, 1024),
       "OpenMP threads stepping environments");
+    v("init_from", self.init_from, Range::Any(),
+      "a fresh run starts from this checkpoint's networks and observation "
+      "normalizer (same character, observation and network sizes); the "
+      "optimizer, initial-state buffers and counters start fresh; empty: "
+      "random weights");
   }
   void Validate() const;
 };

@@ -88,6 +88,20 @@ struct Trainer::State {
     m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
                         initial_states.get(), state_template);
   }
+  // Fine-tuning: the networks and normalizer of `path` (InputError naming it
+  // when its networks do not fit this config); the fixed sigma stays the
+  // config's. Optimizer, buffers and counters stay fresh.
+  void InitializeNetworksFrom(const std::string& path) {
+    const CheckpointCounters from =
+        LoadCheckpoint(path, model, /*optimizer=*/nullptr,
+                       /*initial_states=*/nullptr, state_template);
+    if (!config.model.learn_action_std) {
+      torch::NoGradGuard no_grad;
+      model->LogStd().fill_(std::log(config.model.action_std));
+    }
+    spdlog::info("networks initialized from {} ({} samples of training there)",
+                 path, from.samples);
+  }
 };
 
 Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
@@ -193,6 +207,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     if (resume)
       spdlog::warn("--resume: no checkpoint at {}; starting fresh",
                    s.checkpoint_path);
+    if (!run.init_from.empty()) s.InitializeNetworksFrom(run.init_from);
     TrainingLog::Start(s.log_path);
   }
   // The action noise shares the update's stream, unless the two run at

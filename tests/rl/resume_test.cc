@@ -265,6 +265,71 @@ TEST(Resume, AFixedActionStdFollowsTheConfig) {
   fs::remove_all(dir);
 }
 
+// Fine-tuning: a fresh run (another run folder, another seed) starts from
+// another run's networks and normalizer; counters start at zero.
+TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_init_from");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  RunResult first = TrainIterations(config, /*resume=*/false, 2);
+  const std::string pretrained = first.summary.checkpoint_path;
+
+  TrainConfig tuned = config;
+  tuned.run.run_dir = dir + "/tuned";
+  tuned.run.seed = 9;
+  tuned.run.init_from = pretrained;
+  {
+    Trainer trainer(tuned, /*resume=*/false);
+    trainer.SaveCheckpoint();
+  }
+  auto load = [](const std::string& path, CheckpointCounters* counters) {
+    TrainConfig saved = ReadCheckpointConfig(path);
+    int action_size = 0;
+    ObservationLayout layout = ReadCheckpointLayout(path, &action_size);
+    ActorCritic model(layout, saved.model, action_size);
+    *counters = LoadCheckpoint(path, model, nullptr, nullptr, SimState());
+    return model;
+  };
+  CheckpointCounters from, started;
+  ActorCritic a = load(pretrained, &from);
+  ActorCritic b = load(tuned.run.run_dir + "/checkpoint.pt", &started);
+  EXPECT_EQ(from.iteration, 2);
+  EXPECT_EQ(started.iteration, 0);
+  EXPECT_EQ(started.samples, 0);
+  const auto a_state = a->named_parameters(), b_state = b->named_parameters();
+  for (const auto& item : a_state)
+    EXPECT_TRUE(torch::equal(item.value(), b_state[item.key()])) << item.key();
+  const auto a_buffers = a->named_buffers(), b_buffers = b->named_buffers();
+  ASSERT_GT(a_buffers.size(), 0u);
+  for (const auto& item : a_buffers)
+    EXPECT_TRUE(torch::equal(item.value(), b_buffers[item.key()]))
+        << item.key();
+  // A fresh seed alone gives other weights: the equality is the init's.
+  TrainConfig unrelated = tuned;
+  unrelated.run.run_dir = dir + "/unrelated";
+  unrelated.run.init_from.clear();
+  {
+    Trainer trainer(unrelated, /*resume=*/false);
+    trainer.SaveCheckpoint();
+  }
+  ActorCritic c = load(unrelated.run.run_dir + "/checkpoint.pt", &started);
+  EXPECT_FALSE(torch::equal(a->named_parameters()["actor.0.weight"],
+                            c->named_parameters()["actor.0.weight"]));
+
+  // Networks of other sizes: an error naming the checkpoint.
+  TrainConfig other_sizes = tuned;
+  other_sizes.run.run_dir = dir + "/other_sizes";
+  other_sizes.model.policy_hidden = {24};
+  try {
+    Trainer trainer(other_sizes, /*resume=*/false);
+    ADD_FAILURE() << "networks of other sizes were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(pretrained), std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Resume, AnAdaptiveLearningRateContinuesFromTheCheckpoint) {
   M2D_REQUIRE_SHARED(walk_path, kWalk);
   const std::string dir = testing::TempDir("resume_adaptive_lr");
