@@ -3,9 +3,12 @@
 // `estimate` section (docs/fit.md).
 #include <cstdio>
 #include <iostream>
+#include <optional>
+#include <vector>
 
 #include "cli/commands.h"
 #include "common/error.h"
+#include "eval/fit_accuracy.h"
 #include "fit/fit.h"
 #include "fit/fit_config.h"
 #include "motion/bundle.h"
@@ -23,6 +26,10 @@ struct FitArgs {
   double focal_px = 0.0;
   int threads = 0;  // 0: the config's (default 1)
   std::string character = "characters/humanoid.yaml";
+  // A bundle holding the input's truth (e.g. the original of a stripped
+  // bundle): each view's fit is measured against it after fitting. The fit
+  // never reads it.
+  std::string truth;
   FitOptions options;
   bool quiet = false;
 };
@@ -55,6 +62,22 @@ int RunFit(FitArgs& args) {
   }
   args.options.Validate();
   const ReferenceBundle bundle = ReadBundleOrClip(args.input);
+  std::optional<ReferenceBundle> truth;
+  if (!args.truth.empty()) {
+    truth = ReadBundle(args.truth);
+    if (!truth->ground_truth) {
+      throw InputError(args.truth, "--truth: the bundle holds no 3D truth");
+    }
+    if (truth->views.size() != bundle.views.size() ||
+        truth->num_frames() != bundle.num_frames()) {
+      throw InputError(args.truth,
+                       "--truth: " + std::to_string(truth->views.size()) +
+                           " views of " + std::to_string(truth->num_frames()) +
+                           " frames, but " + args.input + " has " +
+                           std::to_string(bundle.views.size()) + " of " +
+                           std::to_string(bundle.num_frames()));
+    }
+  }
   const std::string character_path = AssetArgumentPath(args.character);
   auto character =
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
@@ -63,6 +86,7 @@ int RunFit(FitArgs& args) {
               CameraMotionName(args.options.camera_motion),
               args.options.fixed_focal_px > 0 ? "fixed" : "estimated");
   int failed_views = 0;
+  std::vector<FitAccuracy> accuracies;
   ReferenceBundle fitted = FitBundle(
       bundle, *character, args.options, args.input,
       [&](int view, const ViewEstimate& estimate) {
@@ -74,10 +98,21 @@ int RunFit(FitArgs& args) {
             kMaxUnconvergedFraction * summary.num_frames) {
           ++failed_views;
         }
+        if (truth) {  // the measurement's side, after the fit
+          accuracies.push_back(
+              MeasureFitAccuracy(estimate, truth->views[view].cameras,
+                                 *truth->ground_truth, *character));
+          std::printf("  against the truth: %s\n",
+                      accuracies.back().BriefReport().c_str());
+        }
         std::fflush(stdout);
       });
   WriteBundle(args.output, fitted);
   std::printf("wrote %s\n", args.output.c_str());
+  if (accuracies.size() > 1) {
+    std::printf("mean over the views, against the truth: %s\n",
+                MeanFitAccuracy(accuracies).BriefReport().c_str());
+  }
   if (failed_views > 0) {
     std::fprintf(stderr,
                  "error: %s: the fit did not converge on more than %.0f%% of "
@@ -120,6 +155,11 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
   fit->add_option("--threads", args->threads, "solver threads (default 1)")
       ->check(CLI::PositiveNumber);
   fit->add_flag("--quiet", args->quiet, "no per-stage progress lines");
+  fit->add_option("--truth", args->truth,
+                  "bundle holding the input's 3D truth and true cameras (a "
+                  "stripped bundle's original): each view's fit is measured "
+                  "against it afterwards (focal, pitch, roll, MPJPE, "
+                  "PA-MPJPE); the fit never reads it");
   fit->callback([run, args] { *run = [args] { return RunFit(*args); }; });
 }
 

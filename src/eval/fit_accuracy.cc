@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "common/error.h"
@@ -161,6 +162,26 @@ FitAccuracy MeanFitAccuracy(const std::vector<FitAccuracy>& accuracies) {
   }
   mean.num_frames = static_cast<int>(std::lround(frames / n));
   return mean;
+}
+
+std::string FitAccuracy::BriefReport() const {
+  char line[512];
+  std::snprintf(
+      line, sizeof(line),
+      "focal %.1f%% (%.0f px, true %.0f), pitch %.1f deg (%.1f, true %.1f), "
+      "roll %.1f deg, MPJPE %.0f mm, PA-MPJPE %.0f mm (reachable %.0f), "
+      "reprojection %.1f px, %.1f s/100 frames, %.0f%% unconverged",
+      focal_error_pct, focal_px, true_focal_px, pitch_error_deg, pitch_deg,
+      true_pitch_deg, roll_error_deg, root_relative_mpjpe_mm, pa_mpjpe_mm,
+      reachable_pa_mpjpe_mm, mean_reprojection_px, seconds_per_100_frames,
+      100.0 * unconverged_fraction);
+  std::string report = line;
+  if (cpu_seconds_per_100_frames > 0) {
+    std::snprintf(line, sizeof(line), " (CPU %.1f s per 100 frames)",
+                  cpu_seconds_per_100_frames);
+    report += line;
+  }
+  return report;
 }
 
 }  // namespace m2d

@@ -5,6 +5,7 @@
 #ifndef MIMIC2D_EVAL_FIT_ACCURACY_H_
 #define MIMIC2D_EVAL_FIT_ACCURACY_H_
 
+#include <string>
 #include <vector>
 
 #include "camera/pinhole.h"
@@ -47,6 +48,9 @@ struct FitAccuracy {
   // other work sharing the cores. Set by a caller that timed the fit (the
   // benchmark); 0 when not measured.
   double cpu_seconds_per_100_frames = 0.0;
+
+  // One line: camera errors, pose errors, reprojection, time.
+  std::string BriefReport() const;
 };
 
 // Measures `estimate` (one view's fit) against that view's true cameras (1

@@ -73,19 +73,6 @@ ReferenceBundle MakeBenchmarkBundle(const Motion3D& motion,
                               name);
 }
 
-std::string AccuracyLine(const FitAccuracy& a) {
-  return Format(
-      "focal %.1f%% (%.0f px, true %.0f), pitch %.1f deg (%.1f, true %.1f), "
-      "roll %.1f deg, MPJPE %.0f mm, PA-MPJPE %.0f mm (reachable %.0f), "
-      "reprojection %.1f px, "
-      "%.1f s/100 frames (CPU %.1f s), %.0f%% unconverged",
-      a.focal_error_pct, a.focal_px, a.true_focal_px, a.pitch_error_deg,
-      a.pitch_deg, a.true_pitch_deg, a.roll_error_deg, a.root_relative_mpjpe_mm,
-      a.pa_mpjpe_mm, a.reachable_pa_mpjpe_mm, a.mean_reprojection_px,
-      a.seconds_per_100_frames, a.cpu_seconds_per_100_frames,
-      100.0 * a.unconverged_fraction);
-}
-
 nlohmann::json AccuracyJson(const FitAccuracy& a) {
   return {{"num_frames", a.num_frames},
           {"focal_error_pct", a.focal_error_pct},
@@ -264,7 +251,7 @@ FitBenchmarkResult RunFitBenchmark(const Character& character,
                 estimate, view.cameras, *bundle.ground_truth, character);
             accuracy.cpu_seconds_per_100_frames =
                 100.0 * cpu_s / accuracy.num_frames;
-            report("    " + AccuracyLine(accuracy));
+            report("    " + accuracy.BriefReport());
             row.views.push_back(accuracy);
             if (options.from_truth) {
               // Stages 2-3 from the truth: the measurement's side, never

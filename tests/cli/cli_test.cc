@@ -361,6 +361,50 @@ TEST(Cli, DeepOrNonFileInputsAreNamedErrors) {
   ExpectInputError("clip info /dev/null", "/dev/null", "not a regular file");
 }
 
+// `fit --truth`: a stripped walk fitted from its 2D, each view measured
+// afterwards against the original's truth; a truth of another shape is
+// named.
+TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
+  M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
+  const std::string dir = testing::TempDir("cli_fit_truth");
+  const std::string truth = dir + "/walk.json",
+                    stripped = dir + "/walk_2d.json";
+  ASSERT_EQ(RunMimic2d("clip from-motion " + walk + " --views 2 -o " + truth)
+                .exit_code,
+            0);
+  ASSERT_EQ(RunMimic2d("clip strip " + truth + " -o " + stripped).exit_code, 0);
+  CommandResult result =
+      RunMimic2d("fit " + stripped + " --focal 1000 --quiet --truth " + truth +
+                 " -o " + dir + "/fitted.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  size_t at = 0;
+  int measured = 0;
+  while ((at = result.output.find("\n  against the truth: focal 0.0%", at)) !=
+         std::string::npos) {
+    ++measured;
+    ++at;
+  }
+  EXPECT_EQ(measured, 2) << result.output;
+  // The walk's fit lands within the accuracy table's figures for it.
+  const size_t mean = result.output.find("mean over the views");
+  ASSERT_NE(mean, std::string::npos) << result.output;
+  const size_t pa = result.output.find("PA-MPJPE ", mean);
+  ASSERT_NE(pa, std::string::npos);
+  EXPECT_LT(std::stod(result.output.substr(pa + 9)), 60.0) << result.output;
+
+  ASSERT_EQ(RunMimic2d("clip from-motion " + walk + " --views 1 -o " + dir +
+                       "/one_view.json")
+                .exit_code,
+            0);
+  ExpectInputError("fit " + stripped + " --quiet --truth " + dir +
+                       "/one_view.json -o " + dir + "/never.json",
+                   dir + "/one_view.json", "--truth: 1 views");
+  ExpectInputError("fit " + stripped + " --quiet --truth " + stripped + " -o " +
+                       dir + "/never.json",
+                   stripped, "holds no 3D truth");
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Cli, UnknownOrMissingCommandsListTheCommands) {
   CommandResult result = RunMimic2d("frobnicate");
   EXPECT_EQ(result.exit_code, 2) << result.output;
