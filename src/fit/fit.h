@@ -92,8 +92,10 @@ struct FitOptions {
   double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
   // Balance (stage 3, frames with a sole in contact): the zero-moment point
   // outside the in-contact soles' box grown by the margin (m); the centre
-  // of mass's acceleration over +-balance_span_s.
-  double balance_weight = 30.0;
+  // of mass's acceleration over +-balance_span_s. Off by default: on
+  // static, focal-known views it tilts the fitted world (docs/fit.md,
+  // "Balance").
+  double balance_weight = 0.0;
   double balance_margin_m = 0.05;
   double balance_span_s = 0.1;
   // The camera's height is weakly observable when the subject stays at one
