@@ -291,11 +291,10 @@ int RunGenerate(const GenerateArgs& args) {
       motion.rows.data(), frames, Coco17Layout(), fps, root_px, scale_px));
   WriteClip(args.output, clip);
   std::printf(
-      "wrote %s: %d frames at %.0f fps (%.1f s) from %d codes of %s, "
-      "generated in %.2f s (%.0fx real time)\n",
+      "wrote %s: %d frames at %.0f fps (%.1f s) from %d codes, generated in "
+      "%.2f s (%.0fx real time)\n",
       args.output.c_str(), frames, fps, frames / fps, motion.num_codes,
-      PriorPathForGeneration(args.run_dir).c_str(), motion.generation_s,
-      frames / fps / std::max(1e-9, motion.generation_s));
+      motion.generation_s, frames / fps / std::max(1e-9, motion.generation_s));
   if (args.policy.empty()) return 0;
   return RunTrackedGenerations(args);
 }
@@ -314,10 +313,10 @@ struct GenEvalArgs {
 int RunGenEval(const GenEvalArgs& args) {
   const GenConfig config = ReadGeneratorConfig(args.run_dir);
   std::printf(
-      "gen eval %s: %d generations x %.0f s from %s; encoder on %zu "
-      "held-apart motions\n",
+      "gen eval %s: %d generations x %.0f s; encoder on %zu held-apart "
+      "motions\n",
       args.run_dir.c_str(), args.options.generations, args.options.seconds,
-      PriorPathForGeneration(args.run_dir).c_str(), args.held_apart.size());
+      args.held_apart.size());
   std::fflush(stdout);
   const GenDataset real = LoadGenDataset(config, config.data.motions);
   const GenDataset held_apart = LoadGenDataset(config, args.held_apart);

@@ -26,9 +26,6 @@ void WriteCommon(torch::serialize::OutputArchive& archive,
   archive.write("seconds", torch::full({1}, state.seconds, torch::kDouble));
   if (state.generator_state.defined())
     archive.write("generator_state", state.generator_state);
-  archive.write("best_validation_loss",
-                torch::full({1}, state.best_validation_loss, torch::kDouble));
-  archive.write("best_step", torch::full({1}, state.best_step, torch::kLong));
 }
 
 GenConfig ReadEmbeddedConfig(const std::string& path,
@@ -65,12 +62,6 @@ void ReadTraining(const std::string& path,
     state->seconds = seconds.item<double>();
     if (archive.try_read("generator_state", generator_state))
       state->generator_state = generator_state;
-    torch::Tensor best_validation_loss, best_step;  // newer checkpoints
-    if (archive.try_read("best_validation_loss", best_validation_loss) &&
-        archive.try_read("best_step", best_step)) {
-      state->best_validation_loss = best_validation_loss.item<double>();
-      state->best_step = best_step.item<int64_t>();
-    }
   });
   if (state->step < 0) throw InputError(path, "negative step count");
 }

@@ -6,7 +6,6 @@
 
 #include <torch/torch.h>
 
-#include <limits>
 #include <string>
 
 #include "gen/gen_config.h"
@@ -20,11 +19,6 @@ struct GenStageState {
   int64_t step = 0;
   double seconds = 0.0;
   torch::Tensor generator_state;  // the batch sampler's random state
-  // The prior: its lowest held-out cross-entropy so far (nats; infinity
-  // before the first) and the step it was reached at; the weights of that
-  // step are kBestPriorFile's (gen_trainer.h).
-  double best_validation_loss = std::numeric_limits<double>::infinity();
-  int64_t best_step = 0;
 };
 
 struct LoadedTokenizer {

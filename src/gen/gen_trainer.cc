@@ -41,11 +41,6 @@ std::string GenTrainSummary::BriefReport() const {
       << "), prior " << prior_steps << " steps ("
       << figure("cross-entropy", prior_loss, " nats") << ")\n"
       << "  checkpoints: " << tokenizer_path << ", " << prior_path << "\n";
-  if (!std::isnan(prior_best_validation_loss)) {
-    out << "  prior: lowest held-out cross-entropy "
-        << prior_best_validation_loss << " nats at step " << prior_best_step
-        << " (" << kBestPriorFile << ", the one generation reads)\n";
-  }
   return out.str();
 }
 
@@ -310,7 +305,6 @@ double TrainPrior(const StageContext& context, bool resume,
                   Gpt& model, GenStageState* state) {
   const GptOptions& options = context.config.prior;
   const std::string path = context.RunFile(kPriorFile);
-  const std::string best_path = context.RunFile(kBestPriorFile);
   torch::optim::AdamW optimizer(
       model->parameters(), torch::optim::AdamWOptions(options.learning_rate)
                                .betas({0.9, 0.99})
@@ -364,11 +358,6 @@ double TrainPrior(const StageContext& context, bool resume,
                         split.validation.targets)
               .item<double>();
       model->train();
-      if (p->validation_loss < state->best_validation_loss) {
-        state->best_validation_loss = p->validation_loss;
-        state->best_step = p->step;
-        SavePrior(best_path, context.config, model, nullptr, *state);
-      }
     }
     char row[256];
     std::snprintf(row, sizeof(row), "%lld,%.2f,%.3g,%.6g,%.4f,%.6g",
@@ -386,13 +375,6 @@ double TrainPrior(const StageContext& context, bool resume,
 }
 
 }  // namespace
-
-std::string PriorPathForGeneration(const std::string& run_dir) {
-  const std::filesystem::path run(run_dir);
-  return std::filesystem::exists(run / kBestPriorFile)
-             ? (run / kBestPriorFile).string()
-             : (run / kPriorFile).string();
-}
 
 GenTrainSummary TrainGenerator(
     const GenConfig& config, const GenDataset& dataset, bool resume,
@@ -433,10 +415,6 @@ GenTrainSummary TrainGenerator(
   summary.prior_loss =
       TrainPrior(context, resume, token_sequences, prior, &prior_state);
   summary.prior_steps = prior_state.step;
-  if (std::isfinite(prior_state.best_validation_loss)) {
-    summary.prior_best_validation_loss = prior_state.best_validation_loss;
-    summary.prior_best_step = prior_state.best_step;
-  }
   summary.interrupted = context.stop_requested();
   return summary;
 }

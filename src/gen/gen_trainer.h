@@ -45,10 +45,6 @@ struct GenTrainSummary {
   double tokenizer_loss = std::numeric_limits<double>::quiet_NaN();
   double prior_loss = std::numeric_limits<double>::quiet_NaN();
   std::string tokenizer_path, prior_path;
-  // The prior's lowest held-out cross-entropy and its step (kBestPriorFile);
-  // NaN and 0 without held-out codes.
-  double prior_best_validation_loss = std::numeric_limits<double>::quiet_NaN();
-  int64_t prior_best_step = 0;
   // A few lines: steps, final losses, codebook use, files.
   std::string BriefReport() const;
 };
@@ -56,15 +52,6 @@ struct GenTrainSummary {
 // Checkpoint file names inside run.run_dir.
 inline constexpr char kTokenizerFile[] = "tokenizer.pt";
 inline constexpr char kPriorFile[] = "prior.pt";
-// The prior at its lowest held-out cross-entropy (weights only), beside
-// prior.pt (the last step's, resumable). Generation reads it when it
-// exists: a prior trained past that point has begun memorizing its
-// sequences.
-inline constexpr char kBestPriorFile[] = "prior_best.pt";
-
-// The prior generation reads in `run_dir`: kBestPriorFile if it exists,
-// else kPriorFile.
-std::string PriorPathForGeneration(const std::string& run_dir);
 
 // Outline: train the tokenizer up to tokenizer.steps (from its checkpoint
 // with `resume`), tokenize every sequence of `dataset`, train the prior up

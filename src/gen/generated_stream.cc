@@ -25,7 +25,7 @@ GeneratedStream::GeneratedStream(const std::string& run_dir,
   format_.image_width_px = options.image_width_px;
   format_.image_height_px = options.image_height_px;
   stream_ = std::make_unique<MotionStream>(
-      std::move(tokenizer), LoadPrior(PriorPathForGeneration(run_dir)),
+      std::move(tokenizer), LoadPrior((run / kPriorFile).string()),
       MotionStreamOptions{options.sampling, options.decoding, options.seed});
 }
 

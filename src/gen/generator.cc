@@ -57,7 +57,7 @@ GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
   CheckGeneration(seconds, sampling);
   const std::filesystem::path run(run_dir);
   return Generate(LoadTokenizer((run / kTokenizerFile).string()),
-                  LoadPrior(PriorPathForGeneration(run_dir)), seconds,
+                  LoadPrior((run / kPriorFile).string()), seconds,
                   {sampling, decoding, seed});
 }
 
@@ -155,7 +155,7 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
   CheckGeneration(options.seconds, options.sampling);
-  const LoadedPrior prior = LoadPrior(PriorPathForGeneration(run_dir));
+  const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
     GeneratedMotion motion = Generate(
         tokenizer, prior, options.seconds,

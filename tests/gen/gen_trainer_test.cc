@@ -83,34 +83,21 @@ TEST(GenTrainer, AResumedRunEndsWhereAnUninterruptedOneDoes) {
   EXPECT_NE(log.find("\n6,"), std::string::npos);
 }
 
-// The prior's held-out tail: its cross-entropy is logged, and the weights
-// of its lowest are kept beside prior.pt and read by generation.
-TEST(GenTrainer, ThePriorKeepsItsLowestHeldOutStep) {
+// The prior's held-out tail (the last context of codes of every long
+// sequence): its cross-entropy is logged at every report.
+TEST(GenTrainer, ThePriorLogsItsHeldOutCrossEntropy) {
   const GenDataset dataset = WalkDataset();  // 30 codes per sequence
-  const GenConfig config = TinyConfig(TempRun("best_prior"));
-  const std::string run = config.run.run_dir;
-  // Before training, generation would read prior.pt.
-  EXPECT_EQ(PriorPathForGeneration(run), run + "/" + kPriorFile);
-  const GenTrainSummary summary =
-      TrainGenerator(config, dataset, false, nullptr, nullptr);
-  ASSERT_TRUE(std::isfinite(summary.prior_best_validation_loss));
-  EXPECT_GE(summary.prior_best_step, 1);
-  EXPECT_LE(summary.prior_best_step, config.prior.steps);
-  EXPECT_EQ(PriorPathForGeneration(run), run + "/" + kBestPriorFile);
-  EXPECT_NE(summary.BriefReport().find("lowest held-out cross-entropy"),
-            std::string::npos);
-  const LoadedPrior best = LoadPrior(run + "/" + kBestPriorFile);
-  EXPECT_EQ(best.model->num_codes(), config.tokenizer.num_codes);
-  // Every logged row has a finite held-out figure.
-  std::istringstream log(ReadFileText(run + "/prior_log.csv"));
+  const GenConfig config = TinyConfig(TempRun("held_out"));
+  TrainGenerator(config, dataset, false, nullptr, nullptr);
+  std::istringstream log(ReadFileText(config.run.run_dir + "/prior_log.csv"));
   std::string line;
   std::getline(log, line);
-  EXPECT_NE(line.find("validation_cross_entropy"), std::string::npos);
+  EXPECT_NE(line.find(",validation_cross_entropy"), std::string::npos);
   int rows = 0;
   while (std::getline(log, line)) {
     const double held_out = std::stod(line.substr(line.rfind(',') + 1));
     EXPECT_TRUE(std::isfinite(held_out)) << line;
-    EXPECT_GE(held_out, summary.prior_best_validation_loss - 1e-9) << line;
+    EXPECT_GT(held_out, 0.0) << line;
     ++rows;
   }
   EXPECT_GE(rows, 2);
