@@ -108,9 +108,8 @@ std::string RunWalkPolicy(const DemoArgs& args) {
   replay.render.pose_label = "character (policy)";
   replay.output.video_path = args.output_dir + "/walk_policy.mp4";
   std::cout << "  video: " << view << " from frame " << start_frame << "\n";
-  EpisodeSummary video =
-      RenderCheckpointRollout(args.walk_policy, fitted, replay, start_frame,
-                              eval.episode_s, sources);
+  EpisodeSummary video = RenderCheckpointRollout(
+      args.walk_policy, fitted, replay, start_frame, eval.episode_s, sources);
   return video.video_path;
 }
 
