@@ -199,7 +199,6 @@ TokenSplit SplitTokensForValidation(
     targets.push_back(torch::from_blob(const_cast<int64_t*>(data + n - context),
                                        {context}, torch::kLong)
                           .clone());
-    split.held_out_codes += context;
   }
   if (!inputs.empty()) {
     split.validation.inputs = torch::stack(inputs);

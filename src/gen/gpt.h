@@ -101,7 +101,6 @@ TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
 struct TokenSplit {
   std::vector<std::vector<int64_t>> training;
   TokenBatch validation;
-  int held_out_codes = 0;
 };
 TokenSplit SplitTokensForValidation(
     const std::vector<std::vector<int64_t>>& sequences, int context);

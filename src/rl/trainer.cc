@@ -88,6 +88,18 @@ struct Trainer::State {
     m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
                         initial_states.get(), state_template);
   }
+  // A fixed sigma is a setting, not learned state: after loading weights the
+  // config decides it (e.g. less exploration later in a long run).
+  void ApplyConfiguredActionStd() {
+    if (config.model.learn_action_std) return;
+    const double saved_std = model->LogStd().exp().mean().item<double>();
+    if (std::abs(saved_std - config.model.action_std) > 1e-9) {
+      spdlog::info("action_std {} -> {} (from the config)", saved_std,
+                   config.model.action_std);
+    }
+    torch::NoGradGuard no_grad;
+    model->LogStd().fill_(std::log(config.model.action_std));
+  }
   // Fine-tuning: the networks and normalizer of `path` (InputError naming it
   // when its networks do not fit this config); the fixed sigma stays the
   // config's. Optimizer, buffers and counters stay fresh.
@@ -95,10 +107,7 @@ struct Trainer::State {
     const CheckpointCounters from =
         LoadCheckpoint(path, model, /*optimizer=*/nullptr,
                        /*initial_states=*/nullptr, state_template);
-    if (!config.model.learn_action_std) {
-      torch::NoGradGuard no_grad;
-      model->LogStd().fill_(std::log(config.model.action_std));
-    }
+    ApplyConfiguredActionStd();
     spdlog::info("networks initialized from {} ({} samples of training there)",
                  path, from.samples);
   }
@@ -168,17 +177,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
         run.seed + s.counters.iteration);
     spdlog::info("resumed from {} at iteration {} ({} samples)",
                  s.checkpoint_path, s.counters.iteration, s.counters.samples);
-    // A fixed sigma is a setting, not learned state: the config decides it
-    // (e.g. lowering exploration noise for the later part of a long run).
-    if (!config.model.learn_action_std) {
-      const double saved_std = s.model->LogStd().exp().mean().item<double>();
-      if (std::abs(saved_std - config.model.action_std) > 1e-9) {
-        spdlog::info("action_std {} -> {} (from the config)", saved_std,
-                     config.model.action_std);
-      }
-      torch::NoGradGuard no_grad;
-      s.model->LogStd().fill_(std::log(config.model.action_std));
-    }
+    s.ApplyConfiguredActionStd();
     const LastLogRow last_row =
         TrainingLog::TrimTo(s.log_path, s.counters.iteration);
     // A fixed rate is a setting; an adaptive one is training state and

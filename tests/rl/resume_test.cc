@@ -99,14 +99,20 @@ void AppendToLog(const std::string& run_dir, const std::string& text) {
   std::ofstream(run_dir + "/train_log.csv", std::ios::app) << text;
 }
 
-CheckpointCounters ReadCounters(const std::string& path,
-                                torch::Tensor* log_std = nullptr) {
+// The networks of a checkpoint, built from its own config, and its counters.
+ActorCritic ReadModel(const std::string& path, CheckpointCounters* counters) {
   TrainConfig config = ReadCheckpointConfig(path);
   int action_size = 0;
   ObservationLayout layout = ReadCheckpointLayout(path, &action_size);
   ActorCritic model(layout, config.model, action_size);
-  CheckpointCounters counters =
-      LoadCheckpoint(path, model, nullptr, nullptr, SimState());
+  *counters = LoadCheckpoint(path, model, nullptr, nullptr, SimState());
+  return model;
+}
+
+CheckpointCounters ReadCounters(const std::string& path,
+                                torch::Tensor* log_std = nullptr) {
+  CheckpointCounters counters;
+  ActorCritic model = ReadModel(path, &counters);
   if (log_std != nullptr) *log_std = model->LogStd().detach().clone();
   return counters;
 }
@@ -282,17 +288,9 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
     Trainer trainer(tuned, /*resume=*/false);
     trainer.SaveCheckpoint();
   }
-  auto load = [](const std::string& path, CheckpointCounters* counters) {
-    TrainConfig saved = ReadCheckpointConfig(path);
-    int action_size = 0;
-    ObservationLayout layout = ReadCheckpointLayout(path, &action_size);
-    ActorCritic model(layout, saved.model, action_size);
-    *counters = LoadCheckpoint(path, model, nullptr, nullptr, SimState());
-    return model;
-  };
   CheckpointCounters from, started;
-  ActorCritic a = load(pretrained, &from);
-  ActorCritic b = load(tuned.run.run_dir + "/checkpoint.pt", &started);
+  ActorCritic a = ReadModel(pretrained, &from);
+  ActorCritic b = ReadModel(tuned.run.run_dir + "/checkpoint.pt", &started);
   EXPECT_EQ(from.iteration, 2);
   EXPECT_EQ(started.iteration, 0);
   EXPECT_EQ(started.samples, 0);
@@ -312,7 +310,7 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
     Trainer trainer(unrelated, /*resume=*/false);
     trainer.SaveCheckpoint();
   }
-  ActorCritic c = load(unrelated.run.run_dir + "/checkpoint.pt", &started);
+  ActorCritic c = ReadModel(unrelated.run.run_dir + "/checkpoint.pt", &started);
   EXPECT_FALSE(torch::equal(a->named_parameters()["actor.0.weight"],
                             c->named_parameters()["actor.0.weight"]));
 
