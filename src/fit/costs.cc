@@ -328,6 +328,64 @@ bool BalanceCost::Evaluate(double const* const* blocks, double* residuals,
   return true;
 }
 
+std::vector<int32_t> LeanBlockSizes(const KinematicModel& model) {
+  return {kRootPositionSize, kRootQuaternionSize, model.num_hinges()};
+}
+
+bool LeanCost::Evaluate(double const* const* blocks, double* residuals,
+                        double** jacobians) const {
+  // Outline: the centre of mass and the posed sole points, each with its
+  // Jacobian; the offset; its rows chained into the three pose blocks.
+  const int num_hinges = model->num_hinges();
+  const int columns = PoseJacobianColumns(*model);
+  ZeroJacobians(jacobians, LeanBlockSizes(*model), 2);
+  double com[3];
+  std::vector<double> com_jacobian(3 * columns);
+  CenterOfMassWithJacobian(*model, blocks[0], blocks[1], blocks[2], com,
+                           com_jacobian.data());
+  const PosedPoints posed(*model, blocks[0], blocks[1], blocks[2]);
+  const int first_sole = model->num_keypoints();
+  double total = 0.0;
+  for (double w : contact_weights) total += w;
+  for (int k = 0; k < 2; ++k) {
+    double support_m = 0.0;
+    for (int s = 0; s < model->num_sole_points(); ++s)
+      support_m += contact_weights[s] * posed.points[3 * (first_sole + s) + k];
+    residuals[k] = weight * (com[k] - support_m / total - target_m[k]);
+  }
+  if (jacobians == nullptr) return true;
+  constexpr int kBlockStart[3] = {0, kRootPositionSize,
+                                  kRootPositionSize + kRootQuaternionSize};
+  const int block_size[3] = {kRootPositionSize, kRootQuaternionSize,
+                             num_hinges};
+  // The offset does not depend on the root's position (the centre of mass
+  // and the soles move with it alike): that block stays 0, exactly.
+  double* const pose_jacobians[3] = {nullptr, jacobians[1], jacobians[2]};
+  for (int k = 0; k < 2; ++k) {
+    for (int b = 1; b < 3; ++b) {
+      if (jacobians[b] == nullptr) continue;
+      double* row = jacobians[b] + k * block_size[b];
+      const double* source = com_jacobian.data() + k * columns + kBlockStart[b];
+      for (int col = 0; col < block_size[b]; ++col)
+        row[col] += weight * source[col];
+    }
+    double gradient[3] = {0.0, 0.0, 0.0};
+    gradient[k] = 1.0;
+    for (int s = 0; s < model->num_sole_points(); ++s) {
+      if (contact_weights[s] == 0.0) continue;
+      posed.AddPoseRow(first_sole + s, gradient, k,
+                       -weight * contact_weights[s] / total, pose_jacobians,
+                       num_hinges);
+    }
+  }
+  return true;
+}
+
+ceres::CostFunction* LeanCost::Create(LeanCost cost) {
+  const std::vector<int32_t> sizes = LeanBlockSizes(*cost.model);
+  return new AnalyticCostFunction<LeanCost>(std::move(cost), sizes, 2);
+}
+
 ceres::CostFunction* BalanceCost::Create(BalanceCost cost) {
   const std::vector<int32_t> sizes = BalanceBlockSizes(*cost.model);
   return new AnalyticCostFunction<BalanceCost>(std::move(cost), sizes, 2);

@@ -184,6 +184,32 @@ struct BalanceCost {
   static ceres::CostFunction* Create(BalanceCost cost);
 };
 
+// Balance on average (blocks: one frame's root position, quaternion and
+// hinges): a person's centre of mass stands over their feet on average,
+// whatever it does frame by frame. Residuals, 2: weight x (the horizontal
+// offset of the centre of mass from the contact-weighted centre of the
+// in-contact sole points - target), m. The targets (fit.cc,
+// AddMeanBalance) are each frame's own offset less its window's mean
+// offset, both from the estimate the solve starts from: each frame keeps
+// its sway, and the window's mean moves toward zero. A body leaning toward
+// a camera that looks level (how a wrong pitch hides) has its centre of
+// mass in front of its feet the whole time. The whole pose enters: held
+// in the root's frame, the offset let the solver turn the root and bend
+// the hips back, the body's lean unchanged.
+struct LeanCost {
+  const KinematicModel* model;
+  std::vector<double> contact_weights;  // per sole point; some > 0
+  double target_m[2] = {0.0, 0.0};
+  double weight = 0.0;
+
+  // Residuals and requested Jacobians (analytic: the centre of mass's and
+  // the sole points' rows).
+  bool Evaluate(double const* const* blocks, double* residuals,
+                double** jacobians) const;
+
+  static ceres::CostFunction* Create(LeanCost cost);
+};
+
 // weight x (value - prior), element-wise over one block (pose prior: hinge
 // angles toward the rest pose's 0).
 struct PriorCost {

@@ -289,7 +289,12 @@ enum class Stage {
   kRoot,  // camera + root trajectory, torso keypoints, rest pose held
   kPose,  // + every hinge and keypoint, pose prior
   kPoseWithContacts,  // + feet that do not slide while in contact
+  kRefine,  // the same terms, the camera held, the final weights (stage 4)
 };
+
+bool HasContactTerms(Stage stage) {
+  return stage == Stage::kPoseWithContacts || stage == Stage::kRefine;
+}
 
 // Every frame's keypoints then sole points in the world, 3 numbers each
 // (T x (J + S) x 3).
@@ -492,6 +497,64 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
   return mask;
 }
 
+// The mean-balance terms (costs.h LeanCost): the clip cut into windows of
+// options.mean_balance_window_s; in each, the frames with a sole in contact
+// (weight >= 0.5) get a term that moves their centre of mass's offset from
+// those soles by minus the window's mean offset. A window with fewer than a
+// quarter of its frames in contact (a flight) has none.
+void AddMeanBalance(const KinematicModel& model, const FitOptions& options,
+                    double fps, const ContactWeights& contacts,
+                    Parameters& params, ceres::Problem& problem) {
+  const int num_frames = static_cast<int>(params.root_m.size());
+  const int window = std::max(
+      2, static_cast<int>(std::lround(options.mean_balance_window_s * fps)));
+  const auto points = FramePoints(params, model);
+  const int first_sole = 3 * model.num_keypoints();
+  std::vector<double> jacobian(3 * PoseJacobianColumns(model));
+  for (int start = 0; start < num_frames; start += window) {
+    std::vector<LeanCost> terms;
+    std::vector<int> frames;
+    Eigen::Vector2d mean_offset_m = Eigen::Vector2d::Zero();
+    for (int t = start; t < std::min(num_frames, start + window); ++t) {
+      LeanCost term;
+      term.model = &model;
+      term.weight = options.mean_balance_weight;
+      Eigen::Vector2d support_m = Eigen::Vector2d::Zero();
+      double total = 0.0;
+      for (int k = 0; k < model.num_sole_points(); ++k) {
+        const double w = contacts[t][k] >= 0.5 ? contacts[t][k] : 0.0;
+        term.contact_weights.push_back(w);
+        support_m += w * Eigen::Vector2d(points[t][first_sole + 3 * k],
+                                         points[t][first_sole + 3 * k + 1]);
+        total += w;
+      }
+      if (total <= 0.0) continue;
+      double com_m[3];
+      CenterOfMassWithJacobian(
+          model, params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+          params.hinges_rad[t].data(), com_m, jacobian.data());
+      const Eigen::Vector2d offset_m =
+          Eigen::Vector2d(com_m[0], com_m[1]) - support_m / total;
+      term.target_m[0] = offset_m.x();
+      term.target_m[1] = offset_m.y();
+      mean_offset_m += offset_m;
+      terms.push_back(std::move(term));
+      frames.push_back(t);
+    }
+    if (4 * static_cast<int>(terms.size()) < window) continue;
+    mean_offset_m /= static_cast<double>(terms.size());
+    for (size_t i = 0; i < terms.size(); ++i) {
+      terms[i].target_m[0] -= mean_offset_m.x();
+      terms[i].target_m[1] -= mean_offset_m.y();
+      const int t = frames[i];
+      problem.AddResidualBlock(
+          LeanCost::Create(std::move(terms[i])), nullptr,
+          {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+           params.hinges_rad[t].data()});
+    }
+  }
+}
+
 // Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
 // them out).
 void BuildProblem(Stage stage, const Observations& obs,
@@ -549,7 +612,9 @@ void BuildProblem(Stage stage, const Observations& obs,
     if (priors.pose_mixture != nullptr) {
       problem.AddResidualBlock(
           new MixturePriorCost(priors.pose_mixture.get(),
-                               stage == Stage::kPoseWithContacts
+                               stage == Stage::kRefine
+                                   ? options.refine_mixture_weight
+                               : stage == Stage::kPoseWithContacts
                                    ? options.pose_mixture_final_weight
                                    : options.pose_mixture_weight),
           nullptr, hinges);
@@ -560,7 +625,9 @@ void BuildProblem(Stage stage, const Observations& obs,
     }
     if (t >= 1 && t + 1 < num_frames) {
       problem.AddResidualBlock(
-          AccelerationCost::Create(num_hinges, options.pose_smooth_weight),
+          AccelerationCost::Create(
+              num_hinges, stage == Stage::kRefine ? options.refine_smooth_weight
+                                                  : options.pose_smooth_weight),
           nullptr,
           {params.hinges_rad[t - 1].data(), hinges,
            params.hinges_rad[t + 1].data()});
@@ -571,7 +638,7 @@ void BuildProblem(Stage stage, const Observations& obs,
     }
   }
   // Feet that stay put while on the floor.
-  if (stage == Stage::kPoseWithContacts && contacts != nullptr) {
+  if (HasContactTerms(stage) && contacts != nullptr) {
     for (int t = 0; t + 1 < num_frames; ++t) {
       FootSlideCost cost;
       cost.model = &model;
@@ -593,7 +660,7 @@ void BuildProblem(Stage stage, const Observations& obs,
     }
   }
   // The zero-moment point over the support, where a sole is in contact.
-  if (stage == Stage::kPoseWithContacts && contacts != nullptr &&
+  if (HasContactTerms(stage) && contacts != nullptr &&
       options.balance_weight > 0) {
     const int span = std::max(
         1, static_cast<int>(std::lround(options.balance_span_s * obs.fps)));
@@ -618,6 +685,12 @@ void BuildProblem(Stage stage, const Observations& obs,
       problem.AddResidualBlock(BalanceCost::Create(std::move(cost)), nullptr,
                                blocks);
     }
+  }
+  // Balance on average: per window, the mean offset of the centre of mass
+  // from the in-contact soles, each frame's held in its root's frame.
+  if (HasContactTerms(stage) && contacts != nullptr &&
+      options.mean_balance_weight > 0) {
+    AddMeanBalance(model, options, obs.fps, *contacts, params, problem);
   }
   // Orientation blocks live on the unit quaternions.
   for (int t = 0; t < num_frames; ++t) {
@@ -678,6 +751,19 @@ void BuildProblem(Stage stage, const Observations& obs,
           AccelerationCost::Create(3, options.camera_smooth_weight), nullptr,
           {params.centres_m[c - 1].data(), params.centres_m[c].data(),
            params.centres_m[c + 1].data()});
+    }
+  }
+  // Stage 4 refines the pose under the camera the search settled on: with
+  // the weaker smoothness the camera would drift (docs/fit.md,
+  // "Smoothness").
+  if (stage == Stage::kRefine) {
+    if (problem.HasParameterBlock(&params.focal_px))
+      problem.SetParameterBlockConstant(&params.focal_px);
+    if (problem.HasParameterBlock(params.pitch_roll_rad))
+      problem.SetParameterBlockConstant(params.pitch_roll_rad);
+    for (auto& centre : params.centres_m) {
+      if (problem.HasParameterBlock(centre.data()))
+        problem.SetParameterBlockConstant(centre.data());
     }
   }
 }
@@ -949,6 +1035,19 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
         std::to_string(final_stage.initial_cost) + " -> " +
         std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best));
   }
+
+  // Stage 4: the pose refined toward the 2D under the camera held, with
+  // weaker smoothness and prior (SMPLify's falling weights, one step more).
+  if (options.refine_iterations > 0) {
+    const ContactWeights contacts = EstimateContacts(
+        FramePoints(best, model), model, options, obs.fps, true);
+    final_stage = SolveStage(Stage::kRefine, options.refine_iterations, obs,
+                             model, layout, options, priors, &contacts, best);
+    summary.iterations += final_stage.iterations;
+    say("stage 4 (refine, camera held): cost " +
+        std::to_string(final_stage.initial_cost) + " -> " +
+        std::to_string(final_stage.final_cost));
+  }
   summary.final_cost = final_stage.final_cost;
 
   // The estimate and its account.
@@ -1009,8 +1108,9 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   // Outline: read the usable observations; stage 1 fits camera and root
   // trajectory from several facing starts and keeps the lowest cost;
   // stage 2 frees the pose; stage 3 adds non-sliding feet at the contacts
-  // stage 2 found; then report per-frame residuals and the frames that did
-  // not converge.
+  // stage 2 found; stage 4 refines the pose under the camera held, with
+  // weaker smoothness; then report per-frame residuals and the frames that
+  // did not converge.
   options.Validate();
   const auto started = std::chrono::steady_clock::now();
   const KinematicModel model = KinematicModel::FromCharacter(character);
@@ -1109,7 +1209,7 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                         const std::string& source) {
   // Outline: read the observations; express the camera and poses in the
   // fit's frame (the camera's yaw 0, its first centre above the origin),
-  // with every hinge clamped into its range; stages 2 and 3 as FitView;
+  // with every hinge clamped into its range; stages 2 to 4 as FitView;
   // report.
   options.Validate();
   const auto started = std::chrono::steady_clock::now();

@@ -79,7 +79,16 @@ struct FitOptions {
   // The same in stage 3 (contacts): SMPLify's schedule lowers the prior
   // once the pose is in the right basin, so the 2D has the last word.
   double pose_mixture_final_weight = 0.02;
-  double pose_smooth_weight = 4.0;      // hinge acceleration, rad per frame^2
+  double pose_smooth_weight = 4.0;  // hinge acceleration, rad per frame^2
+  // Stage 4 (refine: the camera held) lowers both once more. The 2D term's
+  // residuals are in person sizes (a 4-px error on a 100-px person is
+  // 0.04), so at smoothness 4 a real kick's accelerations cost hundreds of
+  // times its 2D error and the fit smoothed motion away (6-10 px off on the
+  // run, kick and dance). Lowered in stage 3 the camera drifts with the
+  // freer pose, hence a stage of its own (docs/fit.md, "Smoothness and the
+  // refinement").
+  double refine_smooth_weight = 0.5;    // hinge acceleration, rad/frame^2
+  double refine_mixture_weight = 0.01;  // learned prior, per std. dev.
   double root_smooth_weight = 20.0;     // root acceleration, m per frame^2
   double turn_smooth_weight = 8.0;      // root angular accel., rad per frame^2
   double ground_weight = 10.0;          // lowest sole point's height (m)
@@ -98,6 +107,13 @@ struct FitOptions {
   double balance_weight = 0.0;
   double balance_margin_m = 0.05;
   double balance_span_s = 0.1;
+  // Balance on average (stages 3-4, costs.h LeanCost): over each
+  // window of this many seconds, the mean horizontal offset (m) of the
+  // centre of mass from the in-contact soles. Unlike the zero-moment point
+  // it needs no accelerations and no support polygon: a body stands over
+  // its feet on average (docs/fit.md, "Balance on average").
+  double mean_balance_weight = 0.0;
+  double mean_balance_window_s = 1.0;
   // The camera's height is weakly observable when the subject stays at one
   // depth (a following camera): a prior at eye level, log(height / this).
   double camera_height_prior_m = 1.5;
@@ -129,6 +145,7 @@ struct FitOptions {
   int limb_search_iterations = 5;  // per limb start and frame; 0: off
   int screening_iterations = 10;   // stage 2's screening, per facing start
   int pose_stage_iterations = 50;
+  int refine_iterations = 50;  // stage 4; 0: no refinement
   int num_threads = 1;
   double function_tolerance = 1e-6;  // relative cost change that stops
   // A frame whose mean reprojection error exceeds this fraction of the
@@ -167,6 +184,11 @@ struct FitOptions {
       "per hinge angle (rad) from rest");
     v("pose_smooth_weight", self.pose_smooth_weight, weight,
       "hinge acceleration (rad per frame^2)");
+    v("refine_smooth_weight", self.refine_smooth_weight, weight,
+      "hinge acceleration in stage 4 (refine, camera held)");
+    v("refine_mixture_weight", self.refine_mixture_weight, weight,
+      "learned prior in stage 4 (refine, camera held)");
+
     v("root_smooth_weight", self.root_smooth_weight, weight,
       "root acceleration (m per frame^2)");
     v("turn_smooth_weight", self.turn_smooth_weight, weight,
@@ -193,6 +215,10 @@ struct FitOptions {
       "the support box grown by this (m)");
     v("balance_span_s", self.balance_span_s, Range::Above(0),
       "centre-of-mass acceleration over +- this (s)");
+    v("mean_balance_weight", self.mean_balance_weight, weight,
+      "mean centre-of-mass offset from the contact soles per window (m)");
+    v("mean_balance_window_s", self.mean_balance_window_s, Range::Above(0),
+      "window of the mean balance (s)");
     v("camera_height_prior_m", self.camera_height_prior_m, Range::Above(0),
       "camera height prior (m), eye level");
     v("camera_height_prior_weight", self.camera_height_prior_weight, weight,
@@ -220,6 +246,8 @@ struct FitOptions {
       Range::Closed(1, 100000), "stage 2 screening iterations per start");
     v("pose_stage_iterations", self.pose_stage_iterations,
       Range::Closed(1, 100000), "full-pose iterations per round");
+    v("refine_iterations", self.refine_iterations, Range::Closed(0, 100000),
+      "stage 4 iterations (0: no refinement)");
     v("num_threads", self.num_threads, Range::Closed(1, 1024), "Ceres threads");
     v("function_tolerance", self.function_tolerance, Range::Above(0),
       "relative cost change that stops a solve");
@@ -248,7 +276,7 @@ struct FitOptions {
 ViewEstimate FitView(const Clip2D& clip, const Character& character,
                      const FitOptions& options, const std::string& source);
 
-// Stages 2 and 3 of the fit (full pose, then contacts) started from given
+// Stages 2 to 4 of the fit (full pose, contacts, refinement) started from given
 // cameras (1, or one per frame) and poses instead of the fit's own start
 // (hinges clamped into their ranges; the focal held when options.fixed_focal_px
 // says so). For diagnosis: started at the truth (`mimic2d bench fit
