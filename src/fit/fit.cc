@@ -319,10 +319,10 @@ std::vector<std::vector<double>> FramePoints(Parameters& params,
 // frame before it stops.
 using ContactWeights = std::vector<std::vector<double>>;
 
-ContactWeights EstimateContacts(const std::vector<std::vector<double>>& points,
-                                const KinematicModel& model,
-                                const FitOptions& options, double fps,
-                                bool gate_by_speed) {
+ContactWeights EstimateContacts(
+    const std::vector<std::vector<double>>& points, const KinematicModel& model,
+    const FitOptions& options, double fps, bool gate_by_speed,
+    const std::vector<std::vector<char>>* still_feet = nullptr) {
   const int num_frames = static_cast<int>(points.size());
   const int first_sole = 3 * model.num_keypoints();
   const double max_step_m = options.contact_speed_mps / fps;
@@ -341,7 +341,9 @@ ContactWeights EstimateContacts(const std::vector<std::vector<double>>& points,
           near_floor && above_lowest_m < 2.0 * options.contact_height_m
               ? std::exp(-above_lowest_m / options.contact_height_m)
               : 0.0;
-      if (gate_by_speed && t + 1 < num_frames) {
+      if (gate_by_speed && still_feet != nullptr) {
+        if (!(*still_feet)[t][model.sole_foot[s]]) weight = 0.0;
+      } else if (gate_by_speed && t + 1 < num_frames) {
         const double* next = &points[t + 1][first_sole];
         const double step_m = std::hypot(next[3 * s] - sole[3 * s],
                                          next[3 * s + 1] - sole[3 * s + 1]);
@@ -394,21 +396,11 @@ bool BackProjectToPlane(const Observations& obs, const Parameters& params,
 // every reprojection unchanged; it hands stage 3 the subject's travel,
 // which a local solver does not find from a subject walking in place.
 //
-// A foot's step is measured on its observed 2D ankle, back-projected onto
-// the horizontal plane at the fitted ankle's height: the 2D and the ground
-// plane fix it, where the fitted leg's depth (a front view sees a stride
-// only as depth) is pulled toward rest by the pose prior. The camera's
-// step at frame t is minus the weighted median, over a window of about one
-// step, of the in-contact feet's steps: the stance foot moves with the
-// camera for most of the window, so a foot labelled in contact while it
-// lands or lifts (moving fast) is outvoted instead of averaged in.
-void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
-                        const KeypointLayout& layout,
-                        const std::vector<std::vector<double>>& points,
-                        const ContactWeights& contacts, Parameters& params) {
-  const int num_frames = obs.num_frames;
+// Each foot's ankle keypoint (-1: none): the one nearer its sole points.
+std::vector<int> FootAnkles(const KinematicModel& model,
+                            const KeypointLayout& layout,
+                            const std::vector<std::vector<double>>& points) {
   const int num_keypoints = model.num_keypoints();
-  // Each foot's ankle keypoint: the one nearer its sole points.
   const int ankles[2] = {layout.IndexOf("left_ankle"),
                          layout.IndexOf("right_ankle")};
   std::vector<int> foot_ankle(model.num_feet, -1);
@@ -434,6 +426,59 @@ void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
       }
     }
   }
+  return foot_ankle;
+}
+
+// Under a static camera, per frame and foot: whether its observed 2D ankle
+// stands still, moving less over the frame (central difference) than
+// options.contact_speed_mps would move it at the person's image scale
+// (obs.scale_px / rest_scale_m pixels per metre). The fitted feet's own
+// speed is a poor witness there: a stance foot's depth drifts in the
+// estimate, and the 3D gate found 1-11 of the kick's 46 frames in contact
+// (docs/fit.md, "Contacts from the 2D"). A foot whose ankle is unseen at
+// either neighbour counts as moving.
+std::vector<std::vector<char>> ObservedStillFeet(
+    const Observations& obs, const KinematicModel& model,
+    const std::vector<int>& foot_ankle, double rest_scale_m,
+    const FitOptions& options) {
+  std::vector<std::vector<char>> still(obs.num_frames,
+                                       std::vector<char>(model.num_feet, 0));
+  for (int t = 0; t < obs.num_frames; ++t) {
+    const int before = std::max(0, t - 1);
+    const int after = std::min(obs.num_frames - 1, t + 1);
+    if (before == after) continue;
+    const double max_step_px =
+        options.contact_speed_mps / obs.fps * obs.scale_px[t] / rest_scale_m;
+    for (int f = 0; f < model.num_feet; ++f) {
+      const int ankle = foot_ankle[f];
+      if (ankle < 0 || obs.Weight(before, ankle) <= 0 ||
+          obs.Weight(after, ankle) <= 0) {
+        continue;
+      }
+      const double step_px =
+          (obs.Pixel(after, ankle) - obs.Pixel(before, ankle)).norm() /
+          (after - before);
+      still[t][f] = step_px < max_step_px;
+    }
+  }
+  return still;
+}
+
+// A foot's step is measured on its observed 2D ankle, back-projected onto
+// the horizontal plane at the fitted ankle's height: the 2D and the ground
+// plane fix it, where the fitted leg's depth (a front view sees a stride
+// only as depth) is pulled toward rest by the pose prior. The camera's
+// step at frame t is minus the weighted median, over a window of about one
+// step, of the in-contact feet's steps: the stance foot moves with the
+// camera for most of the window, so a foot labelled in contact while it
+// lands or lifts (moving fast) is outvoted instead of averaged in.
+void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
+                        const KeypointLayout& layout,
+                        const std::vector<std::vector<double>>& points,
+                        const ContactWeights& contacts, Parameters& params) {
+  const int num_frames = obs.num_frames;
+  const int num_keypoints = model.num_keypoints();
+  const std::vector<int> foot_ankle = FootAnkles(model, layout, points);
   // Per frame pair (t, t+1): each in-contact foot's horizontal step, and
   // its weight (contact over the step times the ankles' confidence).
   struct FootStep {
@@ -1009,6 +1054,18 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
       " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
 
+  // Which feet stand still, seen in the 2D (static camera only; empty:
+  // the fitted feet's speed decides).
+  const double rest_scale_m = MakeRestPose(model, layout).scale_m;
+  auto still_feet = [&](const std::vector<std::vector<double>>& points) {
+    if (options.camera_motion != CameraMotion::kStatic ||
+        !options.contacts_from_2d) {
+      return std::vector<std::vector<char>>();
+    }
+    return ObservedStillFeet(obs, model, FootAnkles(model, layout, points),
+                             rest_scale_m, options);
+  };
+
   // Stage 3: feet that do not slide, at the contacts the previous solve
   // found; relabelled and solved again, since better contacts move the root
   // and the root's motion sharpens the contacts.
@@ -1025,8 +1082,11 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
             EstimateContacts(points, model, options, obs.fps, pass > 0), best);
       }
     }
-    const ContactWeights contacts = EstimateContacts(
-        FramePoints(best, model), model, options, obs.fps, true);
+    const auto points = FramePoints(best, model);
+    const auto still = still_feet(points);
+    const ContactWeights contacts =
+        EstimateContacts(points, model, options, obs.fps, true,
+                         still.empty() ? nullptr : &still);
     final_stage =
         SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
                    model, layout, options, priors, &contacts, best);
@@ -1039,8 +1099,11 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   // Stage 4: the pose refined toward the 2D under the camera held, with
   // weaker smoothness and prior (SMPLify's falling weights, one step more).
   if (options.refine_iterations > 0) {
-    const ContactWeights contacts = EstimateContacts(
-        FramePoints(best, model), model, options, obs.fps, true);
+    const auto points = FramePoints(best, model);
+    const auto still = still_feet(points);
+    const ContactWeights contacts =
+        EstimateContacts(points, model, options, obs.fps, true,
+                         still.empty() ? nullptr : &still);
     final_stage = SolveStage(Stage::kRefine, options.refine_iterations, obs,
                              model, layout, options, priors, &contacts, best);
     summary.iterations += final_stage.iterations;

@@ -129,6 +129,11 @@ struct FitOptions {
   // Sole points moving faster than this to the next frame are not in
   // contact (a landing or lifting foot).
   double contact_speed_mps = 0.5;
+  // Static camera: a sole is still when its foot's observed 2D ankle moves
+  // slower than contact_speed_mps at the person's image scale, instead of
+  // when the fitted foot does. Off by default until measured with the
+  // trackers (docs/fit.md, "Contacts from the 2D").
+  bool contacts_from_2d = false;
   int contact_rounds = 2;  // stage 3 solves, contacts relabelled before each
 
   // Initializations for the facing ambiguity: the character's heading is
@@ -230,6 +235,8 @@ struct FitOptions {
       "soles within this height are in contact (m)");
     v("contact_speed_mps", self.contact_speed_mps, Range::Above(0),
       "soles faster than this are not in contact (m/s)");
+    v("contacts_from_2d", self.contacts_from_2d, Range::Any(),
+      "static camera: stillness seen on the 2D ankle, not the fitted foot");
     v("contact_rounds", self.contact_rounds, Range::Closed(1, 100),
       "full-pose solves, contacts relabelled before each");
     v("num_facing_starts", self.num_facing_starts, Range::Closed(1, 16),
