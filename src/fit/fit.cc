@@ -477,7 +477,6 @@ void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
                         const std::vector<std::vector<double>>& points,
                         const ContactWeights& contacts, Parameters& params) {
   const int num_frames = obs.num_frames;
-  const int num_keypoints = model.num_keypoints();
   const std::vector<int> foot_ankle = FootAnkles(model, layout, points);
   // Per frame pair (t, t+1): each in-contact foot's horizontal step, and
   // its weight (contact over the step times the ankles' confidence).
@@ -732,7 +731,7 @@ void BuildProblem(Stage stage, const Observations& obs,
     }
   }
   // Balance on average: per window, the mean offset of the centre of mass
-  // from the in-contact soles, each frame's held in its root's frame.
+  // from the in-contact soles moved toward zero.
   if (HasContactTerms(stage) && contacts != nullptr &&
       options.mean_balance_weight > 0) {
     AddMeanBalance(model, options, obs.fps, *contacts, params, problem);
@@ -800,7 +799,7 @@ void BuildProblem(Stage stage, const Observations& obs,
   }
   // Stage 4 refines the pose under the camera the search settled on: with
   // the weaker smoothness the camera would drift (docs/fit.md,
-  // "Smoothness").
+  // "Smoothness and the refinement").
   if (stage == Stage::kRefine) {
     if (problem.HasParameterBlock(&params.focal_px))
       problem.SetParameterBlockConstant(&params.focal_px);

@@ -193,7 +193,6 @@ struct FitOptions {
       "hinge acceleration in stage 4 (refine, camera held)");
     v("refine_mixture_weight", self.refine_mixture_weight, weight,
       "learned prior in stage 4 (refine, camera held)");
-
     v("root_smooth_weight", self.root_smooth_weight, weight,
       "root acceleration (m per frame^2)");
     v("turn_smooth_weight", self.turn_smooth_weight, weight,
