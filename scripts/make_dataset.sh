@@ -5,19 +5,29 @@
 # stripped to their 2D and fitted view by view: what a user with four
 # calibrated videos per clip has (the intrinsics known, `--focal`).
 #
-#   scripts/make_dataset.sh [OUT_DIR]   (default runs/dataset)
+#   scripts/make_dataset.sh [OUT_DIR [FIT_CONFIG]]   (default runs/dataset)
+#
+# FIT_CONFIG: FitOptions as YAML for every fit (docs/fit.md, "Settings");
+# default: the fit's defaults.
 #
 # Writes OUT_DIR/<clip>_truth.json (the measurement's side: eval reads its
 # ground truth for E3D only), <clip>_2d.json (stripped) and <clip>.json (the
 # fit's estimate; what training and eval read), and the same with detector
 # noise (Gaussian 4 px, 5 % of keypoints dropped, seed 11) as
-# <clip>_noisy_truth.json, _noisy_2d.json, _noisy.json. A clip the fit
+# <clip>_noisy_truth.json, _noisy_2d.json, _noisy.json. Each fit's log,
+# <name>_fit.log, ends with its accuracy against the truth (`fit --truth`:
+# measured after the fit, which never reads it). A clip the fit
 # cannot estimate (more than a quarter of a view's frames unconverged, e.g.
 # the crawl) is reported and left out. Clips come from
 # $MIMIC2D_SHARED_DATA (default ../shared/data)/deepmimic/motions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-runs/dataset}
+fit_config=()
+if [ -n "${2:-}" ]; then
+  [ -f "$2" ] || { echo "make_dataset: fit config $2 not found" >&2; exit 1; }
+  fit_config=(--config "$2")
+fi
 shared=${MIMIC2D_SHARED_DATA:-../shared/data}
 motions="$shared/deepmimic/motions"
 bin=build/mimic2d
@@ -46,10 +56,12 @@ make_one() {  # clip index [noisy]
     $bin clip strip "$out/${name}_truth.json" -o "$out/${name}_2d.json" \
       > /dev/null
     if $bin fit "$out/${name}_2d.json" --camera static --focal 1400 --quiet \
+      "${fit_config[@]}" --truth "$out/${name}_truth.json" \
       -o "$out/${name}.json" > "$out/${name}_fit.log" 2>&1; then
       echo "fitted $name"
     else
-      echo "left out $name: $(tail -n 1 "$out/${name}_fit.log")"
+      echo "left out $name: $(grep -m 1 '^error' "$out/${name}_fit.log" ||
+        tail -n 1 "$out/${name}_fit.log")"
     fi
   fi
 }

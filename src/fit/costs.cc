@@ -37,16 +37,24 @@ std::pair<double, double> ValueAndSlope(double x, const Function& function) {
   return {y.a, y.v[0]};
 }
 
-// The forward kinematics of one frame: points and their pose Jacobian.
+// The forward kinematics of one frame: points and, when `with_jacobian`,
+// their pose Jacobian. Ceres asks for residuals alone at every trial step
+// (about half of a fit's evaluations); those skip the Jacobian.
 struct PosedPoints {
   int columns = 0;
   std::vector<double> points, jacobian;  // 3 per point; row-major rows
 
   PosedPoints(const KinematicModel& model, const double* root_m,
-              const double* quaternion_wxyz, const double* hinges_rad)
+              const double* quaternion_wxyz, const double* hinges_rad,
+              bool with_jacobian)
       : columns(PoseJacobianColumns(model)),
-        points(3 * (model.num_keypoints() + model.num_sole_points())),
-        jacobian(points.size() * columns) {
+        points(3 * (model.num_keypoints() + model.num_sole_points())) {
+    if (!with_jacobian) {
+      CharacterPoints(model, root_m, quaternion_wxyz, hinges_rad,
+                      points.data());
+      return;
+    }
+    jacobian.resize(points.size() * columns);
     CharacterPointsWithJacobian(model, root_m, quaternion_wxyz, hinges_rad,
                                 points.data(), jacobian.data());
   }
@@ -118,7 +126,7 @@ bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
   const int num_hinges = model->num_hinges();
   const bool want = jacobians != nullptr;
   ZeroJacobians(jacobians, FrameBlockSizes(*model), NumResiduals(*model));
-  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5]);
+  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5], want);
   double* const no_pose[3] = {nullptr, nullptr, nullptr};
   double* const* pose_jacobians = want ? jacobians + 3 : no_pose;
 
@@ -209,6 +217,23 @@ ceres::CostFunction* FrameCost::Create(FrameCost cost) {
                                              num_residuals);
 }
 
+ceres::CostFunction* LimbCost::Create(LimbCost cost) {
+  const KinematicModel& model = *cost.model;
+  const int num_joints = static_cast<int>(model.joints.size());
+  cost.fixed_orientation.assign(num_joints, Eigen::Matrix3d::Identity());
+  cost.fixed_position.assign(num_joints, Eigen::Vector3d::Zero());
+  JointFrames(model, cost.root_m, cost.quaternion_wxyz, cost.hinges_rad.data(),
+              cost.fixed_orientation.data(), cost.fixed_position.data());
+  cost.moves = JointsMovedBy(model, cost.limb_hinges);
+  const int num_limb_hinges = static_cast<int>(cost.limb_hinges.size());
+  const int num_residuals = cost.NumResiduals();
+  auto* function = new ceres::DynamicAutoDiffCostFunction<LimbCost, 4>(
+      new LimbCost(std::move(cost)));
+  function->AddParameterBlock(num_limb_hinges);
+  function->SetNumResiduals(num_residuals);
+  return function;
+}
+
 bool FootSlideCost::Evaluate(double const* const* blocks, double* residuals,
                              double** jacobians) const {
   // Outline: both frames' points and pose Jacobians; per sole point its
@@ -218,8 +243,9 @@ bool FootSlideCost::Evaluate(double const* const* blocks, double* residuals,
   const int num_soles = model->num_sole_points();
   const int num_hinges = model->num_hinges();
   ZeroJacobians(jacobians, SlideBlockSizes(*model), 2 * num_soles);
-  const PosedPoints before(*model, blocks[0], blocks[1], blocks[2]);
-  const PosedPoints after(*model, blocks[3], blocks[4], blocks[5]);
+  const bool want = jacobians != nullptr;
+  const PosedPoints before(*model, blocks[0], blocks[1], blocks[2], want);
+  const PosedPoints after(*model, blocks[3], blocks[4], blocks[5], want);
   for (int s = 0; s < num_soles; ++s) {
     const int point = num_keypoints + s;
     for (int k = 0; k < 2; ++k) {
@@ -258,9 +284,10 @@ bool BalanceCost::Evaluate(double const* const* blocks, double* residuals,
   double com[3][3];
   std::vector<double> com_jacobian[3];
   for (int f = 0; f < 3; ++f) {
-    com_jacobian[f].resize(3 * columns);
-    CenterOfMassWithJacobian(*model, blocks[3 * f], blocks[3 * f + 1],
-                             blocks[3 * f + 2], com[f], com_jacobian[f].data());
+    if (jacobians != nullptr) com_jacobian[f].resize(3 * columns);
+    CenterOfMassWithJacobian(
+        *model, blocks[3 * f], blocks[3 * f + 1], blocks[3 * f + 2], com[f],
+        jacobians != nullptr ? com_jacobian[f].data() : nullptr);
   }
   Jet9 c[3][3];
   for (int f = 0; f < 3; ++f)
@@ -276,7 +303,8 @@ bool BalanceCost::Evaluate(double const* const* blocks, double* residuals,
   const Jet9 zmp[2] = {c[1][0] - c[1][2] * acceleration[0] / vertical,
                        c[1][1] - c[1][2] * acceleration[1] / vertical};
 
-  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5]);
+  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5],
+                          jacobians != nullptr);
   const int first_sole = model->num_keypoints();
   for (int k = 0; k < 2; ++k) {
     // The support box along this axis: its in-contact sole points' extent.
@@ -340,10 +368,12 @@ bool LeanCost::Evaluate(double const* const* blocks, double* residuals,
   const int columns = PoseJacobianColumns(*model);
   ZeroJacobians(jacobians, LeanBlockSizes(*model), 2);
   double com[3];
-  std::vector<double> com_jacobian(3 * columns);
-  CenterOfMassWithJacobian(*model, blocks[0], blocks[1], blocks[2], com,
-                           com_jacobian.data());
-  const PosedPoints posed(*model, blocks[0], blocks[1], blocks[2]);
+  std::vector<double> com_jacobian(jacobians != nullptr ? 3 * columns : 0);
+  CenterOfMassWithJacobian(
+      *model, blocks[0], blocks[1], blocks[2], com,
+      jacobians != nullptr ? com_jacobian.data() : nullptr);
+  const PosedPoints posed(*model, blocks[0], blocks[1], blocks[2],
+                          jacobians != nullptr);
   const int first_sole = model->num_keypoints();
   double total = 0.0;
   for (double w : contact_weights) total += w;

@@ -89,9 +89,31 @@ struct LimbCost {
   const PoseMixture* limb_mixture = nullptr;
   double mixture_weight = 0.0;
 
+  // Filled by Create from the fields above: every joint's frame at
+  // `hinges_rad` and which joints the limb's hinges move. Only those are
+  // composed in Jets; the rest of the body is constant in this problem.
+  std::vector<char> moves;
+  std::vector<Eigen::Matrix3d> fixed_orientation;
+  std::vector<Eigen::Vector3d> fixed_position;
+
   int NumResiduals() const {
     return 2 * static_cast<int>(keypoints.size()) + model->num_sole_points() +
            static_cast<int>(limb_hinges.size()) + 1;
+  }
+
+  // A body point's world position: composed in Jets when the limb moves
+  // its joint, constant otherwise.
+  template <typename T>
+  fk_internal::Vector3<T> PointAt(
+      const BodyPoint& point, const fk_internal::Matrix3<T>* orientation,
+      const fk_internal::Vector3<T>* position) const {
+    if (moves[point.joint]) {
+      return position[point.joint] +
+             orientation[point.joint] * point.offset_m.cast<T>();
+    }
+    return (fixed_position[point.joint] +
+            fixed_orientation[point.joint] * point.offset_m)
+        .template cast<T>();
   }
 
   template <typename T>
@@ -101,28 +123,27 @@ struct LimbCost {
     for (size_t h = 0; h < hinges_rad.size(); ++h) hinges[h] = T(hinges_rad[h]);
     for (size_t i = 0; i < limb_hinges.size(); ++i)
       hinges[limb_hinges[i]] = blocks[0][i];
-    const T root[3] = {T(root_m[0]), T(root_m[1]), T(root_m[2])};
-    const T quaternion[4] = {T(quaternion_wxyz[0]), T(quaternion_wxyz[1]),
-                             T(quaternion_wxyz[2]), T(quaternion_wxyz[3])};
-    T points[3 * kMaxFitPoints];
-    CharacterPoints(*model, root, quaternion, hinges, points);
+    fk_internal::Matrix3<T> orientation[kMaxFitJoints];
+    fk_internal::Vector3<T> position[kMaxFitJoints];
+    MovedJointFrames(*model, moves, fixed_orientation.data(),
+                     fixed_position.data(), hinges, orientation, position);
     const T focal(focal_px);
     const T pitch_roll[2] = {T(pitch_roll_rad[0]), T(pitch_roll_rad[1])};
     const T centre[3] = {T(centre_m[0]), T(centre_m[1]), T(centre_m[2])};
     T* out = residuals;
     for (size_t k = 0; k < keypoints.size(); ++k, out += 2) {
+      const fk_internal::Vector3<T> point =
+          PointAt(model->keypoints[keypoints[k]], orientation, position);
       T pixel[2];
-      FitProject(focal, pitch_roll, centre, &points[3 * keypoints[k]], cx_px,
-                 cy_px, pixel);
+      FitProject(focal, pitch_roll, centre, point.data(), cx_px, cy_px, pixel);
       for (int c = 0; c < 2; ++c) {
         const T error = (pixel[c] - T(observed_px[k][c])) * T(inv_scale_px);
         out[c] = T(weights[k]) * GemanMcClureResidual(error, sigma);
       }
     }
-    const int first_sole = model->num_keypoints();
-    for (int s = 0; s < model->num_sole_points(); ++s, ++out) {
-      const T& z = points[3 * (first_sole + s) + 2];
-      *out = z < T(0) ? T(penetration_weight) * z : T(0);
+    for (const BodyPoint& sole : model->sole_points) {
+      const T z = PointAt(sole, orientation, position)[2];
+      *out++ = z < T(0) ? T(penetration_weight) * z : T(0);
     }
     const int num_limb_hinges = static_cast<int>(limb_hinges.size());
     if (limb_mixture == nullptr) {
@@ -135,15 +156,9 @@ struct LimbCost {
     return true;
   }
 
-  static ceres::CostFunction* Create(LimbCost cost) {
-    const int num_limb_hinges = static_cast<int>(cost.limb_hinges.size());
-    const int num_residuals = cost.NumResiduals();
-    auto* function = new ceres::DynamicAutoDiffCostFunction<LimbCost, 8>(
-        new LimbCost(std::move(cost)));
-    function->AddParameterBlock(num_limb_hinges);
-    function->SetNumResiduals(num_residuals);
-    return function;
-  }
+  // Fills the derived fields, then the cost function. A limb has 3-4
+  // hinges: Jets 4 wide take them in one pass.
+  static ceres::CostFunction* Create(LimbCost cost);
 };
 
 // Feet that do not slide (blocks: frame t's root position, quaternion,

@@ -1,7 +1,6 @@
 #include "fit/fit.h"
 
 #include <ceres/ceres.h>
-#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -816,28 +815,35 @@ struct StageResult {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   int iterations = 0;
+  double seconds = 0.0;  // wall, the solver's own account
 };
+
+// " (0.41 s)": a stage's time, for progress lines.
+std::string Seconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof(text), " (%.2f s)", seconds);
+  return text;
+}
 
 StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
                        const KinematicModel& model,
                        const KeypointLayout& layout, const FitOptions& options,
                        const FitPriors& priors, const ContactWeights* contacts,
                        Parameters& params) {
-  // CHOLMOD's supernodal factorization opens an OpenMP region per
-  // supernode; on systems this small its threads spent 82 % of a fit's CPU
-  // time spinning at barriers (perf, with a training run on the other
-  // core) and made a 3-s clip's fit 7x slower. It runs on this thread.
-  const int saved_openmp_threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  struct RestoreOpenMpThreads {
-    int threads;
-    ~RestoreOpenMpThreads() { omp_set_num_threads(threads); }
-  } restore{saved_openmp_threads};
   ceres::Problem problem;
   BuildProblem(stage, obs, model, layout, options, priors, contacts, params,
                problem);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  // Eigen's simplicial Cholesky, not CHOLMOD's supernodal one: on systems
+  // this small (a banded normal matrix of some 1,600 unknowns per 46
+  // frames) CHOLMOD's OpenMP pool (4 threads, its own count) and
+  // OpenBLAS's spin more than they work. Until 2026-11-23 they took 82 % of
+  // a fit's CPU time; held to one OpenMP thread, its pool still cost 7-15 %
+  // more CPU than wall and took the other core from a training (docs/fit.md,
+  // "Speed"). Same solutions to the printed digits.
+  if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
+    solver.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver.max_num_iterations = max_iterations;
   solver.num_threads = options.num_threads;
   solver.function_tolerance = options.function_tolerance;
@@ -845,7 +851,8 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   return {summary.initial_cost, summary.final_cost,
-          static_cast<int>(summary.iterations.size())};
+          static_cast<int>(summary.iterations.size()),
+          summary.total_time_in_seconds};
 }
 
 // Stage 1b: each limb's pose, searched frame by frame from every start of
@@ -1051,7 +1058,8 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
                  layout, options, priors, nullptr, best);
   summary.iterations += pose.iterations;
   say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
-      " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best));
+      " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best) +
+      Seconds(pose.seconds));
 
   // Which feet stand still, seen in the 2D (static camera only; empty:
   // the fitted feet's speed decides).
@@ -1092,7 +1100,8 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
     summary.iterations += final_stage.iterations;
     say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
         std::to_string(final_stage.initial_cost) + " -> " +
-        std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best));
+        std::to_string(final_stage.final_cost) + "; " + DescribeCamera(best) +
+        Seconds(final_stage.seconds));
   }
 
   // Stage 4: the pose refined toward the 2D under the camera held, with
@@ -1108,7 +1117,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
     summary.iterations += final_stage.iterations;
     say("stage 4 (refine, camera held): cost " +
         std::to_string(final_stage.initial_cost) + " -> " +
-        std::to_string(final_stage.final_cost));
+        std::to_string(final_stage.final_cost) + Seconds(final_stage.seconds));
   }
   summary.final_cost = final_stage.final_cost;
 
@@ -1219,9 +1228,9 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
     char line[200];
     std::snprintf(line, sizeof(line),
                   "stages 1-2, %s: camera + root cost %.4g -> %.4g, full "
-                  "pose %.4g",
+                  "pose %.4g (%.2f s)",
                   name.c_str(), root.initial_cost, root.final_cost,
-                  screen.final_cost);
+                  screen.final_cost, root.seconds + screen.seconds);
     say(line);
     if (screen.final_cost < best_cost) {
       best = std::move(params);
@@ -1256,9 +1265,13 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
 
   // Stage 1b: each limb searched from a grid of starts, frame by frame.
   if (options.limb_search_iterations > 0) {
+    const auto search_started = std::chrono::steady_clock::now();
     SearchLimbs(obs, model, limbs, options, priors, best);
     say("stage 1b (limb search): " + std::to_string(limbs.size()) + " limbs, " +
-        std::to_string(obs.num_frames) + " frames");
+        std::to_string(obs.num_frames) + " frames" +
+        Seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                              search_started)
+                    .count()));
   }
   return SolvePoseAndReport(obs, model, *clip.layout, character, options,
                             priors, started, summary, best);

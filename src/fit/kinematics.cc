@@ -106,9 +106,7 @@ class PoseJacobianContext {
     constexpr int kFirstHingeColumn = kRootPositionSize + kRootQuaternionSize;
     for (int j = point.joint; j >= 0; j = model_.joints[j].parent) {
       const KinematicModel::Joint& joint = model_.joints[j];
-      const int dofs = joint.type == JointType::kSpherical  ? 3
-                       : joint.type == JointType::kRevolute ? 1
-                                                            : 0;
+      const int dofs = joint.num_hinges();
       const Vector3d lever = world - position_[j];
       for (int d = 0; d < dofs; ++d) {
         const int hinge = joint.first_hinge + d;
@@ -131,6 +129,21 @@ class PoseJacobianContext {
 };
 
 }  // namespace
+
+std::vector<char> JointsMovedBy(const KinematicModel& model,
+                                const std::vector<int>& hinges) {
+  const int num_joints = static_cast<int>(model.joints.size());
+  std::vector<char> moves(num_joints, 0);
+  for (int j = 0; j < num_joints; ++j) {
+    const KinematicModel::Joint& joint = model.joints[j];
+    for (int h : hinges) {
+      if (h >= joint.first_hinge && h < joint.first_hinge + joint.num_hinges())
+        moves[j] = 1;
+    }
+    if (joint.parent >= 0 && moves[joint.parent]) moves[j] = 1;
+  }
+  return moves;
+}
 
 void CharacterPointsWithJacobian(const KinematicModel& model,
                                  const double* root_position_m,
@@ -166,7 +179,22 @@ void CenterOfMassWithJacobian(const KinematicModel& model,
                               const double* hinges_rad, double* com_m,
                               double* jacobian) {
   // Outline: the mass-weighted sum of the bodies' centres and of their
-  // Jacobian rows.
+  // Jacobian rows (without a Jacobian, of the centres alone).
+  if (jacobian == nullptr) {
+    Eigen::Matrix3d orientation[kMaxFitJoints];
+    Eigen::Vector3d position[kMaxFitJoints];
+    JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
+                orientation, position);
+    Eigen::Vector3d com = Eigen::Vector3d::Zero();
+    for (size_t b = 0; b < model.mass_points.size(); ++b) {
+      const BodyPoint& point = model.mass_points[b];
+      com +=
+          model.mass_fractions[b] *
+          (position[point.joint] + orientation[point.joint] * point.offset_m);
+    }
+    for (int c = 0; c < 3; ++c) com_m[c] = com[c];
+    return;
+  }
   const PoseJacobianContext context(model, root_position_m,
                                     root_quaternion_wxyz, hinges_rad);
   const int columns = PoseJacobianColumns(model);
@@ -330,7 +358,7 @@ std::vector<Limb> FindLimbs(const KinematicModel& model) {
     for (int j = root; j < num_joints; ++j) {
       const auto& joint = model.joints[j];
       if (!moves[j] || joint.first_hinge < 0 || !in_subtree(j, root)) continue;
-      const int size = joint.type == JointType::kSpherical ? 3 : 1;
+      const int size = joint.num_hinges();
       for (int i = 0; i < size; ++i) {
         const int h = joint.first_hinge + i;
         const double low = model.hinge_low_rad[h],

@@ -38,6 +38,13 @@ struct KinematicModel {
     Eigen::Vector3d axis = Eigen::Vector3d::UnitY();     // revolute only
     int first_hinge = -1;        // index into the hinge angles; -1: none
     double revolute_sign = 1.0;  // MJCF angle = sign x angle about axis
+
+    // Hinge angles this joint owns: 3 for a ball, 1 for a hinge.
+    int num_hinges() const {
+      return type == JointType::kSpherical  ? 3
+             : type == JointType::kRevolute ? 1
+                                            : 0;
+    }
   };
   std::string skeleton_name;
   std::vector<Joint> joints;           // parents precede children
@@ -116,6 +123,29 @@ Matrix3<T> IntrinsicXyzRotation(const T* angles) {
 inline constexpr int kMaxFitJoints = 64;   // FromCharacter checks the count
 inline constexpr int kMaxFitPoints = 128;  // keypoints + sole points, checked
 
+namespace fk_internal {
+
+// A joint's rotation relative to its parent's frame.
+template <typename T>
+Matrix3<T> LocalRotation(const KinematicModel::Joint& joint,
+                         const T* root_quaternion_wxyz, const T* hinges_rad) {
+  Matrix3<T> local = Matrix3<T>::Identity();
+  if (joint.type == JointType::kFree) {
+    T rotation_row_major[9];
+    ceres::QuaternionToRotation(root_quaternion_wxyz, rotation_row_major);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) local(r, c) = rotation_row_major[3 * r + c];
+  } else if (joint.type == JointType::kSpherical) {
+    local = IntrinsicXyzRotation(hinges_rad + joint.first_hinge);
+  } else if (joint.type == JointType::kRevolute) {
+    local = AxisRotation<T>(
+        joint.axis, T(joint.revolute_sign) * hinges_rad[joint.first_hinge]);
+  }
+  return local;
+}
+
+}  // namespace fk_internal
+
 // Every joint's world frame (orientation and origin), parents before
 // children: the forward kinematics that CharacterPoints and
 // CharacterPointsWithJacobian share.
@@ -124,24 +154,12 @@ void JointFrames(const KinematicModel& model, const T* root_position_m,
                  const T* root_quaternion_wxyz, const T* hinges_rad,
                  fk_internal::Matrix3<T>* orientation,
                  fk_internal::Vector3<T>* position) {
-  using fk_internal::AxisRotation;
-  using Matrix3 = fk_internal::Matrix3<T>;
   using Vector3 = fk_internal::Vector3<T>;
   const int num_joints = static_cast<int>(model.joints.size());
   for (int j = 0; j < num_joints; ++j) {
     const KinematicModel::Joint& joint = model.joints[j];
-    Matrix3 local = Matrix3::Identity();
-    if (joint.type == JointType::kFree) {
-      T rotation_row_major[9];
-      ceres::QuaternionToRotation(root_quaternion_wxyz, rotation_row_major);
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) local(r, c) = rotation_row_major[3 * r + c];
-    } else if (joint.type == JointType::kSpherical) {
-      local = fk_internal::IntrinsicXyzRotation(hinges_rad + joint.first_hinge);
-    } else if (joint.type == JointType::kRevolute) {
-      local = AxisRotation<T>(
-          joint.axis, T(joint.revolute_sign) * hinges_rad[joint.first_hinge]);
-    }
+    const fk_internal::Matrix3<T> local =
+        fk_internal::LocalRotation(joint, root_quaternion_wxyz, hinges_rad);
     const Vector3 offset = joint.offset_m.cast<T>();
     if (joint.parent < 0) {
       position[j] =
@@ -152,6 +170,43 @@ void JointFrames(const KinematicModel& model, const T* root_position_m,
       position[j] = position[joint.parent] + orientation[joint.parent] * offset;
       orientation[j] = orientation[joint.parent] * local;
     }
+  }
+}
+
+// Per joint: 1 when one of `hinges` (indices into a frame's hinge angles)
+// turns it, its own or an ancestor's; parents precede children.
+std::vector<char> JointsMovedBy(const KinematicModel& model,
+                                const std::vector<int>& hinges);
+
+// JointFrames for the joints flagged in `moves` alone (none of them the
+// root), the others' frames given in doubles (`fixed_orientation`,
+// `fixed_position`, as JointFrames computed them): a limb's frames when
+// only its hinges vary, without carrying the rest of the body in Jets.
+template <typename T>
+void MovedJointFrames(const KinematicModel& model,
+                      const std::vector<char>& moves,
+                      const Eigen::Matrix3d* fixed_orientation,
+                      const Eigen::Vector3d* fixed_position,
+                      const T* hinges_rad, fk_internal::Matrix3<T>* orientation,
+                      fk_internal::Vector3<T>* position) {
+  const int num_joints = static_cast<int>(model.joints.size());
+  for (int j = 0; j < num_joints; ++j) {
+    if (!moves[j]) continue;
+    const KinematicModel::Joint& joint = model.joints[j];
+    const fk_internal::Matrix3<T> local =
+        fk_internal::LocalRotation<T>(joint, nullptr, hinges_rad);
+    const int parent = joint.parent;
+    const fk_internal::Matrix3<T> parent_orientation =
+        moves[parent] ? orientation[parent]
+                      : fk_internal::Matrix3<T>(
+                            fixed_orientation[parent].template cast<T>());
+    const fk_internal::Vector3<T> parent_position =
+        moves[parent] ? position[parent]
+                      : fk_internal::Vector3<T>(
+                            fixed_position[parent].template cast<T>());
+    position[j] =
+        parent_position + parent_orientation * joint.offset_m.cast<T>();
+    orientation[j] = parent_orientation * local;
   }
 }
 
@@ -200,7 +255,8 @@ void CharacterPointsWithJacobian(const KinematicModel& model,
 
 // The whole body's centre of mass (world, m) into `com_m` (3), with its
 // derivatives with respect to the pose in `jacobian` (row-major 3 x
-// PoseJacobianColumns): the mass-weighted mean of the bodies' centres.
+// PoseJacobianColumns; null: none): the mass-weighted mean of the bodies'
+// centres.
 void CenterOfMassWithJacobian(const KinematicModel& model,
                               const double* root_position_m,
                               const double* root_quaternion_wxyz,

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -422,6 +423,48 @@ TEST(FitKinematics, FindsTheLimbsAndTheirStarts) {
       {"right_knee", "right_ankle"},
       {"nose", "left_eye", "right_eye", "left_ear", "right_ear"}};
   EXPECT_EQ(found, expected);
+}
+
+// The limb search composes only the joints a limb's hinges move, the rest
+// of the body held in doubles (MovedJointFrames in LimbCost): for every
+// limb, a changed limb pose must land each joint where the whole chain
+// puts it.
+TEST(FitKinematics, MovedJointFramesMatchTheWholeChain) {
+  auto character = Humanoid();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  const int num_joints = static_cast<int>(model.joints.size());
+  std::mt19937_64 rng(5);
+  for (const Limb& limb : FindLimbs(model)) {
+    const RandomPose before = MakeRandomPose(model, rng);
+    RandomPose after = before;
+    const RandomPose other = MakeRandomPose(model, rng);
+    for (int h : limb.hinges) after.hinges_rad[h] = other.hinges_rad[h];
+    std::vector<Eigen::Matrix3d> fixed_orientation(num_joints);
+    std::vector<Eigen::Vector3d> fixed_position(num_joints);
+    JointFrames(model, before.root_m.data(), before.quaternion_wxyz.data(),
+                before.hinges_rad.data(), fixed_orientation.data(),
+                fixed_position.data());
+    std::vector<Eigen::Matrix3d> whole_orientation(num_joints);
+    std::vector<Eigen::Vector3d> whole_position(num_joints);
+    JointFrames(model, after.root_m.data(), after.quaternion_wxyz.data(),
+                after.hinges_rad.data(), whole_orientation.data(),
+                whole_position.data());
+    // The joints below the limb's first hinge move; the trunk does not.
+    const std::vector<char> moves = JointsMovedBy(model, limb.hinges);
+    const int num_moved = std::count(moves.begin(), moves.end(), 1);
+    ASSERT_GT(num_moved, 0);
+    ASSERT_LT(num_moved, num_joints);
+    std::vector<Eigen::Matrix3d> orientation(num_joints);
+    std::vector<Eigen::Vector3d> position(num_joints);
+    MovedJointFrames(model, moves, fixed_orientation.data(),
+                     fixed_position.data(), after.hinges_rad.data(),
+                     orientation.data(), position.data());
+    for (int j = 0; j < num_joints; ++j) {
+      if (!moves[j]) continue;
+      EXPECT_LT((position[j] - whole_position[j]).norm(), 1e-12) << j;
+      EXPECT_LT((orientation[j] - whole_orientation[j]).norm(), 1e-12) << j;
+    }
+  }
 }
 
 // A bundle of the walk seen by cameras at known places.
