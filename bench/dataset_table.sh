@@ -37,6 +37,15 @@ bundles() {
 }
 
 # row NAME CHECKPOINT SPLIT NOISE SUFFIX [EVAL FLAGS...]: one table row.
+# The same clips' truth, for the from-2D rows' E3D only (eval --truth: the
+# policy and its task never read it).
+truths() {
+  local clips=$train_clips
+  [ "$1" = unseen ] && clips=$unseen_clips
+  printf -- "--truth "
+  for clip in $clips; do printf -- "%s/%s%s_truth.json " "$data" "$clip" "$2"; done
+}
+
 row() {
   local name=$1 checkpoint=$2 split=$3 noise=$4 suffix=$5
   shift 5
@@ -52,9 +61,10 @@ row() {
   $bin eval "$checkpoint" $(bundles "$split" "$noisy$suffix") \
     --episodes 1 --episode-s 10 "$@" -o "$out/$tag.json" > "$out/$tag.txt"
   # The "all" line: clip view eps frames Succ% E2D EO2D E3D E3Droot E3DPA Jitter.
-  awk -v name="$name" -v split="$split" -v noise="$noise" '
+  # (mawk, Debian's awk, reserves `split`: the clips go in as `clips`.)
+  awk -v name="$name" -v clips="$split" -v noise="$noise" '
     $1 == "all" { printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
-                  name, split, noise, $5, $6, $8, $9, $10, $11 }' \
+                  name, clips, noise, $5, $6, $8, $9, $10, $11 }' \
     "$out/$tag.txt"
 }
 
@@ -63,11 +73,15 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for split in train unseen; do
   for noise in clean noisy; do
     row "3D-GT (truth starts, true cameras)" "$gt" "$split" "$noise" _truth
-    row "ours, 1 view, from 2D (fit's starts and cameras)" "$ours" "$split" "$noise" ""
+    # shellcheck disable=SC2046
+    row "ours, 1 view, from 2D (fit's starts and cameras)" "$ours" "$split" "$noise" "" \
+      $(truths "$split" "$([ "$noise" = noisy ] && echo _noisy)")
     for views in 1 2 3; do
       row "ours, $views view(s), truth starts, true cameras" "$ours" "$split" "$noise" _truth \
         --starts truth --cameras truth --views "$views"
     done
-    row "Sfv* w/ our fit (fit's starts and cameras)" "$sfv" "$split" "$noise" ""
+    # shellcheck disable=SC2046
+    row "Sfv* w/ our fit (fit's starts and cameras)" "$sfv" "$split" "$noise" "" \
+      $(truths "$split" "$([ "$noise" = noisy ] && echo _noisy)")
   done
 done
