@@ -553,7 +553,6 @@ void AddMeanBalance(const KinematicModel& model, const FitOptions& options,
       2, static_cast<int>(std::lround(options.mean_balance_window_s * fps)));
   const auto points = FramePoints(params, model);
   const int first_sole = 3 * model.num_keypoints();
-  std::vector<double> jacobian(3 * PoseJacobianColumns(model));
   for (int start = 0; start < num_frames; start += window) {
     std::vector<LeanCost> terms;
     std::vector<int> frames;
@@ -573,9 +572,9 @@ void AddMeanBalance(const KinematicModel& model, const FitOptions& options,
       }
       if (total <= 0.0) continue;
       double com_m[3];
-      CenterOfMassWithJacobian(
-          model, params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-          params.hinges_rad[t].data(), com_m, jacobian.data());
+      CenterOfMassWithJacobian(model, params.root_m[t].data(),
+                               params.quaternion_wxyz[t].data(),
+                               params.hinges_rad[t].data(), com_m, nullptr);
       const Eigen::Vector2d offset_m =
           Eigen::Vector2d(com_m[0], com_m[1]) - support_m / total;
       term.target_m[0] = offset_m.x();
@@ -839,7 +838,7 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
   // this small (a banded normal matrix of some 1,600 unknowns per 46
   // frames) CHOLMOD's OpenMP pool (4 threads, its own count) and
   // OpenBLAS's spin more than they work. Until 2026-11-23 they took 82 % of
-  // a fit's CPU time; held to one OpenMP thread, its pool still cost 7-15 %
+  // a fit's CPU time; held to one OpenMP thread, its pool still cost 7-9 %
   // more CPU than wall and took the other core from a training (docs/fit.md,
   // "Speed"). Same solutions to the printed digits.
   if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
@@ -1061,16 +1060,19 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
       " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best) +
       Seconds(pose.seconds));
 
-  // Which feet stand still, seen in the 2D (static camera only; empty:
-  // the fitted feet's speed decides).
+  // The contacts of the current estimate, gated by the feet standing
+  // still: seen in the 2D (static camera, contacts_from_2d) or by the
+  // fitted feet's speed.
   const double rest_scale_m = MakeRestPose(model, layout).scale_m;
-  auto still_feet = [&](const std::vector<std::vector<double>>& points) {
+  auto current_contacts = [&]() {
+    const auto points = FramePoints(best, model);
     if (options.camera_motion != CameraMotion::kStatic ||
         !options.contacts_from_2d) {
-      return std::vector<std::vector<char>>();
+      return EstimateContacts(points, model, options, obs.fps, true);
     }
-    return ObservedStillFeet(obs, model, FootAnkles(model, layout, points),
-                             rest_scale_m, options);
+    const std::vector<std::vector<char>> still = ObservedStillFeet(
+        obs, model, FootAnkles(model, layout, points), rest_scale_m, options);
+    return EstimateContacts(points, model, options, obs.fps, true, &still);
   };
 
   // Stage 3: feet that do not slide, at the contacts the previous solve
@@ -1089,11 +1091,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
             EstimateContacts(points, model, options, obs.fps, pass > 0), best);
       }
     }
-    const auto points = FramePoints(best, model);
-    const auto still = still_feet(points);
-    const ContactWeights contacts =
-        EstimateContacts(points, model, options, obs.fps, true,
-                         still.empty() ? nullptr : &still);
+    const ContactWeights contacts = current_contacts();
     final_stage =
         SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
                    model, layout, options, priors, &contacts, best);
@@ -1107,11 +1105,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   // Stage 4: the pose refined toward the 2D under the camera held, with
   // weaker smoothness and prior (SMPLify's falling weights, one step more).
   if (options.refine_iterations > 0) {
-    const auto points = FramePoints(best, model);
-    const auto still = still_feet(points);
-    const ContactWeights contacts =
-        EstimateContacts(points, model, options, obs.fps, true,
-                         still.empty() ? nullptr : &still);
+    const ContactWeights contacts = current_contacts();
     final_stage = SolveStage(Stage::kRefine, options.refine_iterations, obs,
                              model, layout, options, priors, &contacts, best);
     summary.iterations += final_stage.iterations;
