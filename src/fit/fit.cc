@@ -154,18 +154,28 @@ double FocalPriorPx(const FitOptions& options, const Observations& obs) {
              : std::hypot(static_cast<double>(obs.width_px), obs.height_px);
 }
 
-// What the fit assumes beyond the 2D: the focal length's prior and the
-// learned pose prior (null: the pull toward rest).
+// Per frame, whether the ground term applies (defined below).
+std::vector<char> GroundFrames(const Observations& obs,
+                               const KinematicModel& model,
+                               const KeypointLayout& layout,
+                               const FitOptions& options);
+
+// What the fit assumes beyond the 2D: the focal length's prior, the
+// learned pose prior (null: the pull toward rest) and the frames where a
+// foot can stand on the floor.
 struct FitPriors {
   double focal_px = 0.0;
   std::shared_ptr<const PoseMixture> pose_mixture;
   std::string pose_prior_name = "rest";  // for the summary
+  std::vector<char> ground_frames;       // per frame
 };
 
-FitPriors MakeFitPriors(const Character& character, const FitOptions& options,
+FitPriors MakeFitPriors(const Character& character, const KinematicModel& model,
+                        const KeypointLayout& layout, const FitOptions& options,
                         const Observations& obs, const std::string& source) {
   FitPriors priors;
   priors.focal_px = FocalPriorPx(options, obs);
+  priors.ground_frames = GroundFrames(obs, model, layout, options);
   const std::string& path = character.config().pose_prior_path;
   if (options.pose_prior == PosePriorKind::kRest ||
       (options.pose_prior == PosePriorKind::kAuto && path.empty())) {
@@ -208,6 +218,7 @@ struct Parameters {
 // about the mean of the layout's root keypoints.
 struct RestPose {
   std::vector<double> hinges_rad;
+  std::vector<double> points;  // CharacterPoints at the origin
   Eigen::Vector3d root_keypoint_offset_m = Eigen::Vector3d::Zero();
   double scale_m = 0.0;
 };
@@ -221,8 +232,8 @@ RestPose MakeRestPose(const KinematicModel& model,
   }
   const double origin[3] = {0, 0, 0};
   const double identity[4] = {1, 0, 0, 0};
-  std::vector<double> points(3 *
-                             (model.num_keypoints() + model.num_sole_points()));
+  std::vector<double>& points = rest.points;
+  points.resize(3 * (model.num_keypoints() + model.num_sole_points()));
   CharacterPoints(model, origin, identity, rest.hinges_rad.data(),
                   points.data());
   auto point = [&](int j) {
@@ -435,16 +446,16 @@ std::vector<int> FootAnkles(const KinematicModel& model,
 // speed is a poor witness there: a stance foot's depth drifts in the
 // estimate, and the 3D gate found 1-11 of the kick's 46 frames in contact
 // (docs/fit.md, "Contacts from the 2D"). A foot whose ankle is unseen at
-// either neighbour counts as moving.
+// either end of the difference (+-span_frames) counts as moving.
 std::vector<std::vector<char>> ObservedStillFeet(
     const Observations& obs, const KinematicModel& model,
     const std::vector<int>& foot_ankle, double rest_scale_m,
-    const FitOptions& options) {
+    const FitOptions& options, int span_frames = 1) {
   std::vector<std::vector<char>> still(obs.num_frames,
                                        std::vector<char>(model.num_feet, 0));
   for (int t = 0; t < obs.num_frames; ++t) {
-    const int before = std::max(0, t - 1);
-    const int after = std::min(obs.num_frames - 1, t + 1);
+    const int before = std::max(0, t - span_frames);
+    const int after = std::min(obs.num_frames - 1, t + span_frames);
     if (before == after) continue;
     const double max_step_px =
         options.contact_speed_mps / obs.fps * obs.scale_px[t] / rest_scale_m;
@@ -461,6 +472,39 @@ std::vector<std::vector<char>> ObservedStillFeet(
     }
   }
   return still;
+}
+
+// Per frame, whether a foot can stand on the floor there: with
+// ground_from_2d under a static camera, where some foot's 2D ankle is still
+// over +-ground_still_span_s (ObservedStillFeet; the feet told apart on the
+// rest pose); otherwise every frame. A jump's flight then pulls no sole
+// onto the floor: held there, a camera looking down turned the flight into
+// travel in depth (docs/fit.md, "Ground where a foot is still").
+std::vector<char> GroundFrames(const Observations& obs,
+                               const KinematicModel& model,
+                               const KeypointLayout& layout,
+                               const FitOptions& options) {
+  std::vector<char> ground(obs.num_frames, 1);
+  if (!options.ground_from_2d ||
+      options.camera_motion != CameraMotion::kStatic) {
+    return ground;
+  }
+  const RestPose rest = MakeRestPose(model, layout);
+  const int span_frames = std::max(
+      1, static_cast<int>(std::lround(options.ground_still_span_s * obs.fps)));
+  const std::vector<std::vector<char>> still =
+      ObservedStillFeet(obs, model, FootAnkles(model, layout, {rest.points}),
+                        rest.scale_m, options, span_frames);
+  const int margin_frames =
+      static_cast<int>(std::lround(options.ground_margin_s * obs.fps));
+  for (int t = 0; t < obs.num_frames; ++t) {
+    ground[t] = 0;
+    for (int u = std::max(0, t - margin_frames);
+         u <= std::min(obs.num_frames - 1, t + margin_frames); ++u) {
+      if (std::count(still[u].begin(), still[u].end(), 1) > 0) ground[t] = 1;
+    }
+  }
+  return ground;
 }
 
 // A foot's step is measured on its observed 2D ankle, back-projected onto
@@ -541,16 +585,15 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
 }
 
 // The mean-balance terms (costs.h LeanCost): the clip cut into windows of
-// options.mean_balance_window_s; in each, the frames with a sole in contact
+// window_s; in each, the frames with a sole in contact
 // (weight >= 0.5) get a term that moves their centre of mass's offset from
 // those soles by minus the window's mean offset. A window with fewer than a
 // quarter of its frames in contact (a flight) has none.
-void AddMeanBalance(const KinematicModel& model, const FitOptions& options,
+void AddMeanBalance(const KinematicModel& model, double weight, double window_s,
                     double fps, const ContactWeights& contacts,
                     Parameters& params, ceres::Problem& problem) {
   const int num_frames = static_cast<int>(params.root_m.size());
-  const int window = std::max(
-      2, static_cast<int>(std::lround(options.mean_balance_window_s * fps)));
+  const int window = std::max(2, static_cast<int>(std::lround(window_s * fps)));
   const auto points = FramePoints(params, model);
   const int first_sole = 3 * model.num_keypoints();
   for (int start = 0; start < num_frames; start += window) {
@@ -560,7 +603,7 @@ void AddMeanBalance(const KinematicModel& model, const FitOptions& options,
     for (int t = start; t < std::min(num_frames, start + window); ++t) {
       LeanCost term;
       term.model = &model;
-      term.weight = options.mean_balance_weight;
+      term.weight = weight;
       Eigen::Vector2d support_m = Eigen::Vector2d::Zero();
       double total = 0.0;
       for (int k = 0; k < model.num_sole_points(); ++k) {
@@ -618,7 +661,7 @@ void BuildProblem(Stage stage, const Observations& obs,
     cost.cy_px = 0.5 * obs.height_px;
     cost.inv_scale_px = 1.0 / obs.median_scale_px;
     cost.sigma = sigma;
-    cost.ground_weight = options.ground_weight;
+    cost.ground_weight = priors.ground_frames[t] ? options.ground_weight : 0.0;
     cost.penetration_weight = options.penetration_weight;
     cost.upright_weight = options.upright_weight;
     for (int j = 0; j < obs.num_keypoints; ++j) {
@@ -730,9 +773,14 @@ void BuildProblem(Stage stage, const Observations& obs,
   }
   // Balance on average: per window, the mean offset of the centre of mass
   // from the in-contact soles moved toward zero.
+  const double mean_balance_weight =
+      options.camera_motion == CameraMotion::kStatic
+          ? options.mean_balance_weight
+          : options.moving_camera_mean_balance_weight;
   if (HasContactTerms(stage) && contacts != nullptr &&
-      options.mean_balance_weight > 0) {
-    AddMeanBalance(model, options, obs.fps, *contacts, params, problem);
+      mean_balance_weight > 0) {
+    AddMeanBalance(model, mean_balance_weight, options.mean_balance_window_s,
+                   obs.fps, *contacts, params, problem);
   }
   // Orientation blocks live on the unit quaternions.
   for (int t = 0; t < num_frames; ++t) {
@@ -1183,10 +1231,19 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
       ReadCharacterObservations(clip, character, options, source);
   const RestPose rest = MakeRestPose(model, *clip.layout);
   const std::vector<Limb> limbs = FindLimbs(model);
-  const FitPriors priors = MakeFitPriors(character, options, obs, source);
+  const FitPriors priors =
+      MakeFitPriors(character, model, *clip.layout, options, obs, source);
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
+
+  if (options.ground_from_2d &&
+      options.camera_motion == CameraMotion::kStatic) {
+    const auto grounded =
+        std::count(priors.ground_frames.begin(), priors.ground_frames.end(), 1);
+    say("ground term in " + std::to_string(grounded) + " of " +
+        std::to_string(obs.num_frames) + " frames (a 2D ankle still)");
+  }
 
   FitSummary summary;
   summary.camera_model = CameraMotionName(options.camera_motion);
@@ -1296,7 +1353,8 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                                  " cameras; expected 1 or one per frame");
   }
   const PinholeCamera& camera = cameras.front();
-  const FitPriors priors = MakeFitPriors(character, options, obs, source);
+  const FitPriors priors =
+      MakeFitPriors(character, model, *clip.layout, options, obs, source);
   Parameters params;
   params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
                                                : camera.intrinsics().fx_px;
