@@ -326,13 +326,17 @@ std::vector<std::vector<double>> FramePoints(Parameters& params,
 // would make walking in place (both sliding) as cheap as walking. With
 // `gate_by_speed`, a sole point moving faster than `contact_speed_mps` to
 // the next frame is not in contact either: a landing foot is the lowest a
-// frame before it stops.
+// frame before it stops. With `feet_in_2d` (static camera, ObservedFeet
+// below) a foot seen still or moving in the 2D is gated by that instead; an
+// unseen one by its fitted speed as above.
 using ContactWeights = std::vector<std::vector<double>>;
+// What a foot's observed 2D ankle shows at a frame.
+enum class FootIn2d : char { kMoving, kStill, kUnseen };
 
 ContactWeights EstimateContacts(
     const std::vector<std::vector<double>>& points, const KinematicModel& model,
     const FitOptions& options, double fps, bool gate_by_speed,
-    const std::vector<std::vector<char>>* still_feet = nullptr) {
+    const std::vector<std::vector<FootIn2d>>* feet_in_2d = nullptr) {
   const int num_frames = static_cast<int>(points.size());
   const int first_sole = 3 * model.num_keypoints();
   const double max_step_m = options.contact_speed_mps / fps;
@@ -351,8 +355,11 @@ ContactWeights EstimateContacts(
           near_floor && above_lowest_m < 2.0 * options.contact_height_m
               ? std::exp(-above_lowest_m / options.contact_height_m)
               : 0.0;
-      if (gate_by_speed && still_feet != nullptr) {
-        if (!(*still_feet)[t][model.sole_foot[s]]) weight = 0.0;
+      const FootIn2d in_2d = feet_in_2d != nullptr
+                                 ? (*feet_in_2d)[t][model.sole_foot[s]]
+                                 : FootIn2d::kUnseen;
+      if (gate_by_speed && in_2d != FootIn2d::kUnseen) {
+        if (in_2d == FootIn2d::kMoving) weight = 0.0;
       } else if (gate_by_speed && t + 1 < num_frames) {
         const double* next = &points[t + 1][first_sole];
         const double step_m = std::hypot(next[3 * s] - sole[3 * s],
@@ -446,40 +453,49 @@ std::vector<int> FootAnkles(const KinematicModel& model,
 // speed is a poor witness there: a stance foot's depth drifts in the
 // estimate, and the 3D gate found 1-11 of the kick's 46 frames in contact
 // (docs/fit.md, "Contacts from the 2D"). A foot whose ankle is unseen at
-// either end of the difference (+-span_frames) counts as moving.
-std::vector<std::vector<char>> ObservedStillFeet(
+// either end of the difference (+-span_frames) is kUnseen: the 2D says
+// nothing about it, and the callers fall back to what the 2D replaced.
+std::vector<std::vector<FootIn2d>> ObservedFeet(
     const Observations& obs, const KinematicModel& model,
     const std::vector<int>& foot_ankle, double rest_scale_m,
     const FitOptions& options, int span_frames = 1) {
-  std::vector<std::vector<char>> still(obs.num_frames,
-                                       std::vector<char>(model.num_feet, 0));
+  std::vector<std::vector<FootIn2d>> feet(
+      obs.num_frames, std::vector<FootIn2d>(model.num_feet, FootIn2d::kUnseen));
   for (int t = 0; t < obs.num_frames; ++t) {
-    const int before = std::max(0, t - span_frames);
-    const int after = std::min(obs.num_frames - 1, t + span_frames);
-    if (before == after) continue;
     const double max_step_px =
         options.contact_speed_mps / obs.fps * obs.scale_px[t] / rest_scale_m;
     for (int f = 0; f < model.num_feet; ++f) {
       const int ankle = foot_ankle[f];
-      if (ankle < 0 || obs.Weight(before, ankle) <= 0 ||
-          obs.Weight(after, ankle) <= 0) {
-        continue;
+      if (ankle < 0) continue;
+      // The widest difference whose ends are both seen: a dropped detection
+      // at +-span_frames narrows it rather than hiding the foot.
+      for (int span = span_frames; span >= 1; --span) {
+        const int before = std::max(0, t - span);
+        const int after = std::min(obs.num_frames - 1, t + span);
+        if (before == after || obs.Weight(before, ankle) <= 0 ||
+            obs.Weight(after, ankle) <= 0) {
+          continue;
+        }
+        const double step_px =
+            (obs.Pixel(after, ankle) - obs.Pixel(before, ankle)).norm() /
+            (after - before);
+        feet[t][f] =
+            step_px < max_step_px ? FootIn2d::kStill : FootIn2d::kMoving;
+        break;
       }
-      const double step_px =
-          (obs.Pixel(after, ankle) - obs.Pixel(before, ankle)).norm() /
-          (after - before);
-      still[t][f] = step_px < max_step_px;
     }
   }
-  return still;
+  return feet;
 }
 
 // Per frame, whether a foot can stand on the floor there: with
 // ground_from_2d under a static camera, where some foot's 2D ankle is still
-// over +-ground_still_span_s (ObservedStillFeet; the feet told apart on the
-// rest pose); otherwise every frame. A jump's flight then pulls no sole
-// onto the floor: held there, a camera looking down turned the flight into
-// travel in depth (docs/fit.md, "Ground where a foot is still").
+// over +-ground_still_span_s (ObservedFeet; the feet told apart on the rest
+// pose) within +-ground_margin_s, or unseen at the frame itself (a video
+// cropped above the feet keeps its floor); otherwise every frame. A jump's
+// flight then pulls no sole onto the floor: held there, a camera looking
+// down turned the flight into travel in depth (docs/fit.md, "Ground where a
+// foot is still").
 std::vector<char> GroundFrames(const Observations& obs,
                                const KinematicModel& model,
                                const KeypointLayout& layout,
@@ -492,16 +508,19 @@ std::vector<char> GroundFrames(const Observations& obs,
   const RestPose rest = MakeRestPose(model, layout);
   const int span_frames = std::max(
       1, static_cast<int>(std::lround(options.ground_still_span_s * obs.fps)));
-  const std::vector<std::vector<char>> still =
-      ObservedStillFeet(obs, model, FootAnkles(model, layout, {rest.points}),
-                        rest.scale_m, options, span_frames);
+  const std::vector<std::vector<FootIn2d>> feet =
+      ObservedFeet(obs, model, FootAnkles(model, layout, {rest.points}),
+                   rest.scale_m, options, span_frames);
   const int margin_frames =
       static_cast<int>(std::lround(options.ground_margin_s * obs.fps));
+  auto any_foot = [&](int t, FootIn2d what) {
+    return std::count(feet[t].begin(), feet[t].end(), what) > 0;
+  };
   for (int t = 0; t < obs.num_frames; ++t) {
-    ground[t] = 0;
+    ground[t] = any_foot(t, FootIn2d::kUnseen);
     for (int u = std::max(0, t - margin_frames);
          u <= std::min(obs.num_frames - 1, t + margin_frames); ++u) {
-      if (std::count(still[u].begin(), still[u].end(), 1) > 0) ground[t] = 1;
+      if (any_foot(u, FootIn2d::kStill)) ground[t] = 1;
     }
   }
   return ground;
@@ -1118,9 +1137,9 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
         !options.contacts_from_2d) {
       return EstimateContacts(points, model, options, obs.fps, true);
     }
-    const std::vector<std::vector<char>> still = ObservedStillFeet(
+    const std::vector<std::vector<FootIn2d>> feet = ObservedFeet(
         obs, model, FootAnkles(model, layout, points), rest_scale_m, options);
-    return EstimateContacts(points, model, options, obs.fps, true, &still);
+    return EstimateContacts(points, model, options, obs.fps, true, &feet);
   };
 
   // Stage 3: feet that do not slide, at the contacts the previous solve
@@ -1242,7 +1261,8 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
     const auto grounded =
         std::count(priors.ground_frames.begin(), priors.ground_frames.end(), 1);
     say("ground term in " + std::to_string(grounded) + " of " +
-        std::to_string(obs.num_frames) + " frames (a 2D ankle still)");
+        std::to_string(obs.num_frames) +
+        " frames (a 2D ankle still or unseen)");
   }
 
   FitSummary summary;
