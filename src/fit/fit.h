@@ -140,9 +140,10 @@ struct FitOptions {
   bool contacts_from_2d = true;
   // Static camera: the ground term only in frames where a foot can stand,
   // those where some foot's observed 2D ankle is still (as above) over a
-  // central difference of +-ground_still_span_s; elsewhere (a jump's
-  // flight) only the penetration term holds the feet. Off: every frame
-  // (docs/fit.md, "Ground where a foot is still").
+  // central difference of +-ground_still_span_s, or unseen; where every
+  // foot is seen moving (a jump's flight) only the penetration term holds
+  // the feet. Off: every frame (docs/fit.md, "Ground where a foot is
+  // still").
   bool ground_from_2d = true;
   double ground_still_span_s = 0.1;  // longer than a frame: detector noise
   // A frame this close to a still one keeps the ground term too: an ankle
