@@ -50,7 +50,7 @@ row() {
   local name=$1 checkpoint=$2 split=$3 noise=$4 suffix=$5
   shift 5
   local tag
-  tag=$(echo "$name-$split-$noise" | tr ' ,*' '___')
+  tag=$(echo "$name-$split-$noise" | tr ' ,*/' '____')
   if [ ! -f "$checkpoint" ]; then
     echo "| $name | $split | $noise | (no checkpoint $checkpoint) | | | | | |"
     return
