@@ -603,8 +603,8 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
   return mask;
 }
 
-// The mean-balance terms (costs.h LeanCost): the clip cut into windows of
-// window_s; in each, the frames with a sole in contact
+// The mean-balance terms (costs.h LeanCost), each of `weight`: the clip cut
+// into windows of window_s; in each, the frames with a sole in contact
 // (weight >= 0.5) get a term that moves their centre of mass's offset from
 // those soles by minus the window's mean offset. A window with fewer than a
 // quarter of its frames in contact (a flight) has none.
