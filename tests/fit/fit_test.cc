@@ -584,6 +584,15 @@ KickFits FitKickWithAndWithout(const Character& character,
   return fits;
 }
 
+// `options` without the static camera's cues from the 2D (contacts, ground
+// and balance on average; configs/fit/no_static_cues.yaml).
+FitOptions WithoutStaticCues(FitOptions options) {
+  options.contacts_from_2d = false;
+  options.ground_from_2d = false;
+  options.mean_balance_weight = 0.0;
+  return options;
+}
+
 // The kick raises a leg to hip height and swings the arms; from rest a local
 // solver leaves them hanging (the 2D fits 13 px off, PA-MPJPE 131 mm when
 // this was written). The limb search (stage 1b) finds them. Measured
@@ -592,10 +601,7 @@ KickFits FitKickWithAndWithout(const Character& character,
 // (6.3 -> 4.4 px, 78 -> 59 mm with them; docs/fit.md, "Static-camera cues").
 TEST(Fit, LimbSearchFindsARaisedLeg) {
   auto character = Humanoid();
-  FitOptions with;
-  with.contacts_from_2d = false;
-  with.ground_from_2d = false;
-  with.mean_balance_weight = 0.0;
+  const FitOptions with = WithoutStaticCues(FitOptions());
   FitOptions without = with;
   without.limb_search_iterations = 0;
   const KickFits fits = FitKickWithAndWithout(*character, without, "from rest",
@@ -697,11 +703,8 @@ TEST(Fit, GroundFromThe2dLetsAJumpLeaveTheFloor) {
   const ReferenceBundle bundle = MakeBundleFromMotion(
       motion, character->keypoint_map(), bundle_options, "jump");
   const ReferenceView& view = bundle.views[0];
-  FitOptions every_frame;
+  FitOptions every_frame = WithoutStaticCues(FitOptions());
   every_frame.fixed_focal_px = 1400.0;
-  every_frame.ground_from_2d = false;
-  every_frame.contacts_from_2d = false;
-  every_frame.mean_balance_weight = 0.0;
   FitOptions still_frames = every_frame;
   still_frames.ground_from_2d = true;
 
