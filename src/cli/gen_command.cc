@@ -343,6 +343,8 @@ int RunGenEval(const GenEvalArgs& args) {
         {"emit_codes", args.options.decoding.emit_codes},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},
+        {"time_segments", args.options.time_segments},
+        {"fid_by_time_segment", result.fid_by_time_segment},
         {"real_windows", result.real_windows},
         {"held_apart_windows", result.held_apart_windows},
         {"generated_windows", result.generated_windows},
@@ -413,6 +415,9 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Codes whose frames one decoding emits");
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
+  eval->add_option("--time-segments", eval_args->options.time_segments,
+                   "Also score each generation's k-th part of this many "
+                   "alone (drift as the context slides)");
   eval->add_option("-o,--output", eval_args->output, "Figures as JSON");
   eval->callback([run, eval_args] {
     *run = [eval_args] { return RunGenEval(*eval_args); };

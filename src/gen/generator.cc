@@ -78,6 +78,9 @@ std::string GeneratorEvalResult::BriefReport() const {
       << "windows: real " << real_windows << ", held apart "
       << held_apart_windows << " (encoder loss " << encoder_loss
       << "), generated " << generated_windows << "\n"
+      << "FID by time segment of the generations:";
+  for (double segment_fid : fid_by_time_segment) out << " " << segment_fid;
+  out << "\n"
       << "generation speed " << realtime_factor
       << "x real time (1 thread, tokens + decoding)\n";
   return out.str();
@@ -155,6 +158,15 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
   CheckGeneration(options.seconds, options.sampling);
+  const int segment_frames = static_cast<int>(
+      options.seconds * real.fps / std::max(1, options.time_segments));
+  if (options.time_segments < 1 || segment_frames < options.window_frames) {
+    throw ConfigError(
+        "gen eval: " + std::to_string(options.time_segments) +
+        " time segments of " + std::to_string(options.seconds) +
+        " s are shorter than a " + std::to_string(options.window_frames) +
+        "-frame window; use fewer segments or longer generations");
+  }
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
     GeneratedMotion motion = Generate(
@@ -173,11 +185,26 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       EncodeWindows(encoder, generated_windows);
 
   // 4. The figures.
-  result.fid = FrechetDistance(FitFeatureGaussian(generated_features),
-                               FitFeatureGaussian(real_features));
+  const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
+  result.fid =
+      FrechetDistance(FitFeatureGaussian(generated_features), real_gaussian);
   result.diversity_real = MeanPairDistance(real_features, 300, options.seed);
   result.diversity_generated =
       MeanPairDistance(generated_features, 300, options.seed);
+  if (options.time_segments > 1) {
+    std::vector<std::vector<GenSequence>> segments(options.time_segments);
+    for (const GenSequence& sequence : generated) {
+      std::vector<GenSequence> parts =
+          CutSequenceInTime(sequence, frame_size, options.time_segments);
+      for (int k = 0; k < options.time_segments; ++k)
+        segments[k].push_back(std::move(parts[k]));
+    }
+    for (const std::vector<GenSequence>& segment : segments) {
+      result.fid_by_time_segment.push_back(FrechetDistance(
+          FitFeatureGaussian(EncodeWindows(encoder, windows_of(segment))),
+          real_gaussian));
+    }
+  }
   return result;
 }
 

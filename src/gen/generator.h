@@ -41,6 +41,10 @@ struct GeneratorEvalOptions {
   int stride_frames = 16;
   int64_t encoder_steps = 3000;
   uint64_t seed = 1;  // encoder initialization and batches
+  // Each generation is also cut into this many equal parts in time, and
+  // the windows of each part scored alone: a prior that drifts away from
+  // the data as its context slides scores worse in the later parts.
+  int time_segments = 4;
 };
 
 struct GeneratorEvalResult {
@@ -60,6 +64,10 @@ struct GeneratorEvalResult {
   double fid_floor_views = 0.0, fid_floor_time = 0.0;
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;
+  // FID vs real of the generated windows in each time segment (the k-th
+  // part of every generation; equal window counts, so comparable with each
+  // other, not with `fid`, which has more windows and less bias).
+  std::vector<double> fid_by_time_segment;
   double realtime_factor = 0.0;  // generated seconds per second of CPU
                                  // time, one LibTorch thread
   std::string BriefReport() const;

@@ -105,18 +105,34 @@ int64_t GenDataset::num_frames() const {
   return frames;
 }
 
+std::vector<GenSequence> CutSequenceInTime(const GenSequence& sequence,
+                                           int frame_size, int num_parts) {
+  if (num_parts < 1 || num_parts > sequence.num_frames) {
+    throw ConfigError("cannot cut " + std::to_string(sequence.num_frames) +
+                      " frames of " + sequence.name + " into " +
+                      std::to_string(num_parts) + " parts");
+  }
+  std::vector<GenSequence> parts;
+  int start = 0;
+  for (int k = 0; k < num_parts; ++k) {
+    // Part k ends at floor((k + 1) n / parts): the shorter parts first.
+    const int end = static_cast<int>(
+        static_cast<int64_t>(k + 1) * sequence.num_frames / num_parts);
+    const auto begin = sequence.features.begin();
+    parts.push_back({sequence.name + "/" + std::to_string(k + 1), end - start,
+                     {begin + static_cast<size_t>(start) * frame_size,
+                      begin + static_cast<size_t>(end) * frame_size}});
+    start = end;
+  }
+  return parts;
+}
+
 std::pair<GenSequence, GenSequence> SplitSequenceInTime(
     const GenSequence& sequence, int frame_size) {
-  const int first_frames = sequence.num_frames / 2;
-  const auto middle = sequence.features.begin() +
-                      static_cast<size_t>(first_frames) * frame_size;
-  GenSequence first{sequence.name + "/first",
-                    first_frames,
-                    {sequence.features.begin(), middle}};
-  GenSequence second{sequence.name + "/second",
-                     sequence.num_frames - first_frames,
-                     {middle, sequence.features.end()}};
-  return {std::move(first), std::move(second)};
+  std::vector<GenSequence> halves = CutSequenceInTime(sequence, frame_size, 2);
+  halves[0].name = sequence.name + "/first";
+  halves[1].name = sequence.name + "/second";
+  return {std::move(halves[0]), std::move(halves[1])};
 }
 
 void FeatureStatistics(const std::vector<GenSequence>& sequences,

@@ -91,6 +91,13 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
                            const GenViewOptions& views, double fps,
                            double loop_to_s);
 
+// `sequence` cut in time into `num_parts` consecutive parts of equal
+// length (the last ones a frame longer when it does not divide), named
+// "<name>/<k>" from 1; rows as they are. ConfigError if a part would be
+// empty.
+std::vector<GenSequence> CutSequenceInTime(const GenSequence& sequence,
+                                           int frame_size, int num_parts);
+
 // `sequence` cut at its middle frame into its first and second half
 // ("<name>/first", "<name>/second"; rows as they are).
 std::pair<GenSequence, GenSequence> SplitSequenceInTime(

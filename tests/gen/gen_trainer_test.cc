@@ -188,6 +188,7 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   options.window_frames = 16;
   options.stride_frames = 8;
   options.encoder_steps = 20;
+  options.time_segments = 2;  // 45 frames each: 4 windows per generation
   const GeneratorEvalResult result =
       EvaluateGenerator(config.run.run_dir, walk, walk, options);
   EXPECT_EQ(result.generated_windows, 2 * ((90 - 16) / 8 + 1));
@@ -198,6 +199,15 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_GT(result.diversity_generated, 0.0);
   EXPECT_GT(result.realtime_factor, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));
+  ASSERT_EQ(result.fid_by_time_segment.size(), 2u);
+  for (double segment_fid : result.fid_by_time_segment) {
+    EXPECT_TRUE(std::isfinite(segment_fid));
+    EXPECT_GE(segment_fid, 0.0);
+  }
+  // Segments shorter than a window are refused, not scored on nothing.
+  options.time_segments = 10;
+  EXPECT_THROW(EvaluateGenerator(config.run.run_dir, walk, walk, options),
+               ConfigError);
   // What a user gets from `generate`: the frames asked for, finite.
   const GeneratedMotion motion =
       GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.8, 5}, 4);

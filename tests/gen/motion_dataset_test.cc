@@ -110,5 +110,29 @@ TEST(GenDataset, ASequenceSplitInTimeKeepsEveryRowOnce) {
   EXPECT_EQ(second.features.back(), 14.0f);
 }
 
+TEST(GenDataset, ASequenceCutInTimeKeepsEveryRowOnceInOrder) {
+  const int frame_size = 2;
+  GenSequence sequence{"walk/0", 10, {}};
+  for (int i = 0; i < 10 * frame_size; ++i)
+    sequence.features.push_back(static_cast<float>(i));
+  const std::vector<GenSequence> parts =
+      CutSequenceInTime(sequence, frame_size, 3);
+  ASSERT_EQ(parts.size(), 3u);
+  EXPECT_EQ(parts[0].name, "walk/0/1");
+  EXPECT_EQ(parts[2].name, "walk/0/3");
+  EXPECT_EQ(parts[0].num_frames, 3);  // the shorter parts first
+  EXPECT_EQ(parts[1].num_frames, 3);
+  EXPECT_EQ(parts[2].num_frames, 4);
+  std::vector<float> joined;
+  for (const GenSequence& part : parts) {
+    ASSERT_EQ(part.features.size(),
+              static_cast<size_t>(part.num_frames) * frame_size);
+    joined.insert(joined.end(), part.features.begin(), part.features.end());
+  }
+  EXPECT_EQ(joined, sequence.features);
+  EXPECT_THROW(CutSequenceInTime(sequence, frame_size, 11), ConfigError);
+  EXPECT_THROW(CutSequenceInTime(sequence, frame_size, 0), ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
