@@ -90,6 +90,16 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                                       const GenDataset& real,
                                       const GenDataset& held_apart,
                                       const GeneratorEvalOptions& options) {
+  // Refused before any work: segments too short to hold a window.
+  const int segment_frames = static_cast<int>(
+      options.seconds * real.fps / std::max(1, options.time_segments));
+  if (options.time_segments < 1 || segment_frames < options.window_frames) {
+    throw ConfigError(
+        "gen eval: " + std::to_string(options.time_segments) +
+        " time segments of " + std::to_string(options.seconds) +
+        " s are shorter than a " + std::to_string(options.window_frames) +
+        "-frame window; use fewer segments or longer generations");
+  }
   const std::filesystem::path run(run_dir);
   LoadedTokenizer tokenizer = LoadTokenizer((run / kTokenizerFile).string());
   const int frame_size = real.frame_size;
@@ -158,15 +168,6 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
   CheckGeneration(options.seconds, options.sampling);
-  const int segment_frames = static_cast<int>(
-      options.seconds * real.fps / std::max(1, options.time_segments));
-  if (options.time_segments < 1 || segment_frames < options.window_frames) {
-    throw ConfigError(
-        "gen eval: " + std::to_string(options.time_segments) +
-        " time segments of " + std::to_string(options.seconds) +
-        " s are shorter than a " + std::to_string(options.window_frames) +
-        "-frame window; use fewer segments or longer generations");
-  }
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
     GeneratedMotion motion = Generate(
