@@ -112,8 +112,7 @@ struct GenerateArgs {
   std::string output;
   double seconds = 10.0;
   uint64_t seed = 1;
-  double temperature = 1.0;
-  int top_k = 0;
+  SamplingOptions sampling;
   std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
   double focal_px = 1000.0;
   // --policy: a tracker checkpoint driven along `generations` streams
@@ -202,7 +201,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
         character, config.env.simulation, first_camera, {root_px, scale_px});
     for (int g = 0; g < args.generations; ++g) {
       GeneratedStreamOptions stream_options;
-      stream_options.sampling = {args.temperature, args.top_k};
+      stream_options.sampling = args.sampling;
       stream_options.seed = args.seed + g;
       stream_options.first_root_px = root_px;
       stream_options.first_scale_px = scale_px;
@@ -276,11 +275,8 @@ int RunGenerate(const GenerateArgs& args) {
                               !args.azimuths_deg.empty()))
     throw ConfigError(
         "generate: --video, --generations and --azimuths need --policy");
-  SamplingOptions sampling;
-  sampling.temperature = args.temperature;
-  sampling.top_k = args.top_k;
   const GeneratedMotion motion =
-      GenerateMotion(args.run_dir, args.seconds, sampling, args.seed);
+      GenerateMotion(args.run_dir, args.seconds, args.sampling, args.seed);
   const int frames = motion.num_frames;
   const double fps = motion.fps;
 
@@ -330,10 +326,13 @@ int RunGenEval(const GenEvalArgs& args) {
         {"seconds", args.options.seconds},
         {"temperature", args.options.sampling.temperature},
         {"top_k", args.options.sampling.top_k},
+        {"kept_context_tokens", args.options.sampling.kept_context_tokens},
         {"held_apart", args.held_apart},
         {"fid", result.fid},
         {"fid_floor_time", result.fid_floor_time},
         {"fid_floor_views", result.fid_floor_views},
+        {"fid_floor_sampled", result.fid_floor_sampled},
+        {"fid_floor_sampled_segment", result.fid_floor_sampled_segment},
         {"fid_reconstruction", result.fid_reconstruction},
         {"reconstruction_pose_error", result.reconstruction_pose_error},
         {"reconstruction_root_error", result.reconstruction_root_error},
@@ -353,6 +352,18 @@ int RunGenEval(const GenEvalArgs& args) {
     WriteFileAtomic(args.output, json.dump(2) + "\n");
   }
   return 0;
+}
+
+// The sampling flags `gen eval` and `generate` share.
+void AddSamplingOptions(CLI::App* command, SamplingOptions* sampling) {
+  command->add_option("--temperature", sampling->temperature,
+                      "Sampling temperature (> 0; lower is greedier)");
+  command->add_option("--top-k", sampling->top_k,
+                      "Sample among the k likeliest codes (0: all)");
+  command->add_option(
+      "--kept-context", sampling->kept_context_tokens,
+      "Codes of the past the prior keeps in view when its full context "
+      "slides (0: half the context)");
 }
 
 }  // namespace
@@ -398,10 +409,7 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Independent generations (seeds 1..N)");
   eval->add_option("--seconds", eval_args->options.seconds,
                    "Length of each generation (s)");
-  eval->add_option("--temperature", eval_args->options.sampling.temperature,
-                   "Sampling temperature");
-  eval->add_option("--top-k", eval_args->options.sampling.top_k,
-                   "Sample among the k likeliest codes (0: all)");
+  AddSamplingOptions(eval, &eval_args->options.sampling);
   eval->add_option("--held-apart", eval_args->held_apart,
                    "Motions the feature encoder is trained on (never the "
                    "generator's)")
@@ -437,10 +445,7 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
   generate->add_option("--seconds", generate_args->seconds,
                        "Length of the generated motion (s)");
   generate->add_option("--seed", generate_args->seed, "Sampling seed");
-  generate->add_option("--temperature", generate_args->temperature,
-                       "Sampling temperature (> 0; lower is greedier)");
-  generate->add_option("--top-k", generate_args->top_k,
-                       "Sample among the k likeliest codes (0: all)");
+  AddSamplingOptions(generate, &generate_args->sampling);
   generate
       ->add_option("--view", generate_args->view,
                    "Camera azimuth (deg), elevation (deg), distance (m)")

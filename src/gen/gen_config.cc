@@ -94,8 +94,10 @@ std::string GenSettingsReference() {
 }
 
 void SamplingOptions::Validate() const {
-  if (!(temperature > 0) || top_k < 0)
-    throw ConfigError("sampling: temperature must be > 0 and top_k >= 0");
+  if (!(temperature > 0) || top_k < 0 || kept_context_tokens < 0)
+    throw ConfigError(
+        "sampling: temperature must be > 0, top_k and kept_context_tokens "
+        ">= 0");
 }
 
 }  // namespace m2d

@@ -131,7 +131,12 @@ struct GptOptions {
 struct SamplingOptions {
   double temperature = 1.0;  // > 0; lower is greedier
   int top_k = 0;             // sample among the k likeliest codes (0: all)
-  void Validate() const;     // throws ConfigError
+  // Codes kept when the prior's full context slides: generation restarts
+  // its attention from the last `kept_context_tokens` codes (0: half the
+  // context). More keeps more of the motion's past in view after each
+  // restart and restarts more often (a pass over the kept codes each).
+  int kept_context_tokens = 0;
+  void Validate() const;  // throws ConfigError
 };
 
 // How the stream decodes codes into frames (gen/motion_stream.h).

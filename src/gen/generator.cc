@@ -68,7 +68,8 @@ std::string GeneratorEvalResult::BriefReport() const {
   out << "FID generated vs real " << fid << "; floors, real vs real: halves "
       << "in time " << fid_floor_time << " (ratio " << ratio(fid_floor_time)
       << "), halves by view " << fid_floor_views << " (ratio "
-      << ratio(fid_floor_views) << ")\n"
+      << ratio(fid_floor_views) << "); as many real stretches as generations "
+      << fid_floor_sampled << " (ratio " << ratio(fid_floor_sampled) << ")\n"
       << "FID of the tokenizer's reconstructions vs real " << fid_reconstruction
       << "; mean |error|: local pose " << reconstruction_pose_error
       << ", root step " << reconstruction_root_error << ", log-scale step "
@@ -80,6 +81,9 @@ std::string GeneratorEvalResult::BriefReport() const {
       << "), generated " << generated_windows << "\n"
       << "FID by time segment of the generations:";
   for (double segment_fid : fid_by_time_segment) out << " " << segment_fid;
+  if (!fid_by_time_segment.empty())
+    out << " (real stretches of a segment's length: "
+        << fid_floor_sampled_segment << ")";
   out << "\n"
       << "generation speed " << realtime_factor
       << "x real time (1 thread, tokens + decoding)\n";
@@ -93,6 +97,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   // Refused before any work: segments too short to hold a window.
   const int segment_frames = static_cast<int>(
       options.seconds * real.fps / std::max(1, options.time_segments));
+  if (options.floor_draws < 1)
+    throw ConfigError("gen eval: floor_draws must be at least 1");
   if (options.time_segments < 1 || segment_frames < options.window_frames) {
     throw ConfigError(
         "gen eval: " + std::to_string(options.time_segments) +
@@ -162,6 +168,28 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                         FitFeatureGaussian(real_features));
   }
 
+  // The floors at the generations' sample size: as many real stretches as
+  // generations, as long as a generation (and as a segment), scored alike.
+  const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
+  auto sampled_floor = [&](int stretch_frames) {
+    double sum = 0.0;
+    for (int d = 0; d < options.floor_draws; ++d) {
+      const std::vector<GenSequence> stretches =
+          DrawRealStretches(real.sequences, frame_size, stretch_frames,
+                            options.generations, options.seed + 1000 + d);
+      sum += FrechetDistance(
+          FitFeatureGaussian(EncodeWindows(encoder, windows_of(stretches))),
+          real_gaussian);
+    }
+    return sum / options.floor_draws;
+  };
+  const int generation_frames =
+      static_cast<int>(std::lround(options.seconds * real.fps));
+  result.fid_floor_sampled = sampled_floor(generation_frames);
+  if (options.time_segments > 1) {
+    result.fid_floor_sampled_segment = sampled_floor(segment_frames);
+  }
+
   // 3. Generated features; generation timed on one thread.
   const int threads = torch::get_num_threads();
   torch::set_num_threads(1);
@@ -186,7 +214,6 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       EncodeWindows(encoder, generated_windows);
 
   // 4. The figures.
-  const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
   result.fid =
       FrechetDistance(FitFeatureGaussian(generated_features), real_gaussian);
   result.diversity_real = MeanPairDistance(real_features, 300, options.seed);

@@ -45,6 +45,8 @@ struct GeneratorEvalOptions {
   // the windows of each part scored alone: a prior that drifts away from
   // the data as its context slides scores worse in the later parts.
   int time_segments = 4;
+  // Draws of real stretches averaged in the sampled floors (below).
+  int floor_draws = 5;
 };
 
 struct GeneratorEvalResult {
@@ -62,6 +64,14 @@ struct GeneratorEvalResult {
   // motion and view in both, no frame in both: real motion that is not the
   // same motion, the floor a generator of new motion is held to).
   double fid_floor_views = 0.0, fid_floor_time = 0.0;
+  // The floor at the generations' own sample size: as many real stretches
+  // as generations, each as long as a generation (all of a shorter
+  // sequence; DrawRealStretches), against every real window; the mean of
+  // `floor_draws` draws. A generator replaying real motion scores this
+  // with so few generations: 100 draws see about 80 of 216 sequences, and
+  // the windows of one stretch are alike. `_segment`: stretches as long as
+  // one time segment, the floor of `fid_by_time_segment`.
+  double fid_floor_sampled = 0.0, fid_floor_sampled_segment = 0.0;
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;
   // FID vs real of the generated windows in each time segment (the k-th

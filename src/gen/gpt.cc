@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+
+#include "common/error.h"
 
 namespace m2d {
 namespace F = torch::nn::functional;
@@ -218,7 +221,12 @@ TokenSampler::TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed)
     : gpt_(std::move(gpt)),
       options_(options),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)) {
-  TORCH_CHECK(options_.temperature > 0, "sampling temperature must be > 0");
+  options_.Validate();
+  if (options_.kept_context_tokens >= gpt_->context_tokens())
+    throw ConfigError("sampling: kept_context_tokens " +
+                      std::to_string(options_.kept_context_tokens) +
+                      " must be below the prior's context of " +
+                      std::to_string(gpt_->context_tokens()) + " codes");
   history_.push_back(gpt_->start_token());
 }
 
@@ -231,10 +239,13 @@ int64_t TokenSampler::Next() {
   const int64_t context = gpt_->context_tokens();
   torch::Tensor logits;
   if (cache_.length == 0 || cache_.length == context) {
-    // A restart: the last half of the context (all of a short history).
+    // A restart: the kept codes (all of a short history).
+    const int64_t kept = options_.kept_context_tokens > 0
+                             ? options_.kept_context_tokens
+                             : context / 2;
     const int64_t keep =
         std::min<int64_t>(static_cast<int64_t>(history_.size()),
-                          cache_.length == context ? context / 2 : context);
+                          cache_.length == context ? kept : context);
     cache_ = GptCache();
     logits = gpt_->ForwardCached(
         torch::tensor(

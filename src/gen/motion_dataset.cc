@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "common/error.h"
 #include "motion/bundle.h"
@@ -105,6 +106,20 @@ int64_t GenDataset::num_frames() const {
   return frames;
 }
 
+namespace {
+
+// Frames [begin, end) of `sequence` as a sequence of their own.
+GenSequence FramesOf(const GenSequence& sequence, int frame_size, int begin,
+                     int end, std::string name) {
+  const auto rows = sequence.features.begin();
+  return {std::move(name),
+          end - begin,
+          {rows + static_cast<size_t>(begin) * frame_size,
+           rows + static_cast<size_t>(end) * frame_size}};
+}
+
+}  // namespace
+
 std::vector<GenSequence> CutSequenceInTime(const GenSequence& sequence,
                                            int frame_size, int num_parts) {
   if (num_parts < 1 || num_parts > sequence.num_frames) {
@@ -116,12 +131,10 @@ std::vector<GenSequence> CutSequenceInTime(const GenSequence& sequence,
   int start = 0;
   for (int k = 0; k < num_parts; ++k) {
     // Part k ends at floor((k + 1) n / parts): the shorter parts first.
-    const int end = static_cast<int>(
-        static_cast<int64_t>(k + 1) * sequence.num_frames / num_parts);
-    const auto begin = sequence.features.begin();
-    parts.push_back({sequence.name + "/" + std::to_string(k + 1), end - start,
-                     {begin + static_cast<size_t>(start) * frame_size,
-                      begin + static_cast<size_t>(end) * frame_size}});
+    const int end = static_cast<int>(static_cast<int64_t>(k + 1) *
+                                     sequence.num_frames / num_parts);
+    parts.push_back(FramesOf(sequence, frame_size, start, end,
+                             sequence.name + "/" + std::to_string(k + 1)));
     start = end;
   }
   return parts;
@@ -133,6 +146,37 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
   halves[0].name = sequence.name + "/first";
   halves[1].name = sequence.name + "/second";
   return {std::move(halves[0]), std::move(halves[1])};
+}
+
+std::vector<GenSequence> DrawRealStretches(
+    const std::vector<GenSequence>& sequences, int frame_size,
+    int stretch_frames, int num_stretches, uint64_t seed) {
+  const bool any_frames =
+      std::any_of(sequences.begin(), sequences.end(),
+                  [](const GenSequence& s) { return s.num_frames > 0; });
+  if (!any_frames || stretch_frames < 1 || num_stretches < 1) {
+    throw ConfigError("cannot draw " + std::to_string(num_stretches) +
+                      " stretches of " + std::to_string(stretch_frames) +
+                      " from " + std::to_string(sequences.size()) +
+                      " sequences: " +
+                      (any_frames ? "count and length must be positive"
+                                  : "no sequence has frames"));
+  }
+  std::mt19937_64 random(seed);
+  std::uniform_int_distribution<size_t> pick(0, sequences.size() - 1);
+  std::vector<GenSequence> stretches;
+  while (static_cast<int>(stretches.size()) < num_stretches) {
+    // Outline: a sequence, a start that leaves a whole stretch when the
+    // sequence holds one, the rows from there.
+    const GenSequence& sequence = sequences[pick(random)];
+    if (sequence.num_frames < 1) continue;
+    const int length = std::min(stretch_frames, sequence.num_frames);
+    const int start = std::uniform_int_distribution<int>(
+        0, sequence.num_frames - length)(random);
+    stretches.push_back(FramesOf(sequence, frame_size, start, start + length,
+                                 sequence.name + "@" + std::to_string(start)));
+  }
+  return stretches;
 }
 
 void FeatureStatistics(const std::vector<GenSequence>& sequences,

@@ -196,6 +196,9 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_GE(result.fid, 0.0);
   EXPECT_GE(result.fid_floor_views, 0.0);
   EXPECT_GE(result.fid_floor_time, 0.0);
+  EXPECT_GE(result.fid_floor_sampled, 0.0);
+  EXPECT_GE(result.fid_floor_sampled_segment, 0.0);
+  EXPECT_TRUE(std::isfinite(result.fid_floor_sampled));
   EXPECT_GT(result.diversity_generated, 0.0);
   EXPECT_GT(result.realtime_factor, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));

@@ -3,6 +3,8 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 
+#include "common/error.h"
+
 namespace m2d {
 namespace {
 
@@ -114,11 +116,17 @@ TEST(Gpt, LearnsACycleAndContinuesItEndlessly) {
     loss = l.item<double>();
   }
   EXPECT_LT(loss, 0.5);  // corrupted inputs keep it above 0
-  TokenSampler sampler(gpt, SamplingOptions{1.0, 1}, 1);
-  for (int i = 0; i < 50; ++i) sampler.Next();
-  const std::vector<int64_t>& codes = sampler.codes();
-  for (size_t i = 1; i < codes.size(); ++i)
-    EXPECT_EQ(codes[i], (codes[i - 1] + 1) % 6) << "at " << i;
+  // However much of the past each slide keeps (0: half the context of 12).
+  for (int kept : {0, 1, 11}) {
+    TokenSampler sampler(gpt, SamplingOptions{1.0, 1, kept}, 1);
+    for (int i = 0; i < 50; ++i) sampler.Next();
+    const std::vector<int64_t>& codes = sampler.codes();
+    for (size_t i = 1; i < codes.size(); ++i)
+      EXPECT_EQ(codes[i], (codes[i - 1] + 1) % 6)
+          << "at " << i << ", kept " << kept;
+  }
+  // A slide that would keep the whole context is refused.
+  EXPECT_THROW(TokenSampler(gpt, SamplingOptions{1.0, 1, 12}, 1), ConfigError);
 }
 
 TEST(Gpt, HeldOutCodesAreNeverTrainedOn) {

@@ -134,5 +134,42 @@ TEST(GenDataset, ASequenceCutInTimeKeepsEveryRowOnceInOrder) {
   EXPECT_THROW(CutSequenceInTime(sequence, frame_size, 0), ConfigError);
 }
 
+TEST(GenDataset, RealStretchesAreDrawnAsTheGenerationsWillBe) {
+  // Two sequences whose rows count frames (row t of sequence k holds
+  // 100 k + t): every stretch is a run of consecutive rows of one of them.
+  const int frame_size = 2;
+  std::vector<GenSequence> sequences(2);
+  for (int k = 0; k < 2; ++k) {
+    sequences[k].name = "walk/" + std::to_string(k);
+    sequences[k].num_frames = k == 0 ? 30 : 8;  // the second is short
+    for (int t = 0; t < sequences[k].num_frames; ++t)
+      for (int c = 0; c < frame_size; ++c)
+        sequences[k].features.push_back(static_cast<float>(100 * k + t));
+  }
+  const std::vector<GenSequence> stretches =
+      DrawRealStretches(sequences, frame_size, 10, 12, 7);
+  ASSERT_EQ(stretches.size(), 12u);
+  bool saw[2] = {false, false};
+  for (const GenSequence& stretch : stretches) {
+    ASSERT_EQ(stretch.features.size(),
+              static_cast<size_t>(stretch.num_frames) * frame_size);
+    const int k = static_cast<int>(stretch.features[0]) / 100;
+    saw[k] = true;
+    // A whole stretch where the sequence holds one, all of a short one.
+    EXPECT_EQ(stretch.num_frames, k == 0 ? 10 : 8) << stretch.name;
+    for (int t = 1; t < stretch.num_frames; ++t)
+      EXPECT_EQ(stretch.features[t * frame_size], stretch.features[0] + t);
+  }
+  EXPECT_TRUE(saw[0] && saw[1]);
+  // The same seed, the same draws.
+  const std::vector<GenSequence> again =
+      DrawRealStretches(sequences, frame_size, 10, 12, 7);
+  ASSERT_EQ(again.size(), stretches.size());
+  for (size_t i = 0; i < again.size(); ++i)
+    EXPECT_EQ(again[i].name, stretches[i].name);
+  EXPECT_THROW(DrawRealStretches({}, frame_size, 10, 95, 7), ConfigError);
+  EXPECT_THROW(DrawRealStretches(sequences, frame_size, 0, 95, 7), ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
