@@ -400,7 +400,7 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
   CLI::App* eval = gen->add_subcommand(
       "eval",
       "FID of generated against real 2D motion (with the real-vs-real "
-      "floor), diversity and generation speed");
+      "floors), diversity and generation speed");
   eval->add_option("run_dir", eval_args->run_dir,
                    "The generator's run folder (tokenizer.pt, prior.pt)")
       ->required()
