@@ -68,9 +68,11 @@ struct GeneratorEvalResult {
   // as generations, each as long as a generation (all of a shorter
   // sequence; DrawRealStretches), against every real window; the mean of
   // `floor_draws` draws. A generator replaying real motion scores this
-  // with so few generations: 100 draws see about 80 of 216 sequences, and
-  // the windows of one stretch are alike. `_segment`: stretches as long as
-  // one time segment, the floor of `fid_by_time_segment`.
+  // with so few generations: 100 draws see about 80 of the long walks' 216
+  // sequences, and the windows of one stretch are alike. `_segment`:
+  // stretches as long as one time segment, the floor of
+  // `fid_by_time_segment` (approximate: stretches from random starts draw a
+  // sequence's first and last seconds less often than its middle).
   double fid_floor_sampled = 0.0, fid_floor_sampled_segment = 0.0;
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;
