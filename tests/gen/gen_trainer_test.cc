@@ -199,6 +199,22 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_GE(result.fid_floor_sampled, 0.0);
   EXPECT_GE(result.fid_floor_sampled_segment, 0.0);
   EXPECT_TRUE(std::isfinite(result.fid_floor_sampled));
+  // Real data with sequences shorter than a window (a clip played once):
+  // the floors draw among those that hold one, as the real windows do.
+  GenDataset with_short = walk;
+  for (const GenSequence& sequence : walk.sequences) {
+    const int short_frames = options.window_frames - 1;
+    with_short.sequences.push_back(
+        {sequence.name + "/short",
+         short_frames,
+         {sequence.features.begin(),
+          sequence.features.begin() +
+              static_cast<size_t>(short_frames) * walk.frame_size}});
+  }
+  const GeneratorEvalResult short_result =
+      EvaluateGenerator(config.run.run_dir, with_short, walk, options);
+  EXPECT_TRUE(std::isfinite(short_result.fid_floor_sampled));
+  EXPECT_EQ(short_result.real_windows, result.real_windows);
   EXPECT_GT(result.diversity_generated, 0.0);
   EXPECT_GT(result.realtime_factor, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));
