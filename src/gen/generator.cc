@@ -171,18 +171,14 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   // The floors at the generations' sample size: as many real stretches as
   // generations, as long as a generation (and as a segment), scored alike.
   const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
-  // Drawn among the sequences that hold a window, as the real windows are
-  // (a once-played kick of 46 frames holds none).
-  std::vector<GenSequence> windowed;
-  for (const GenSequence& sequence : real.sequences)
-    if (sequence.num_frames >= options.window_frames)
-      windowed.push_back(sequence);
   auto sampled_floor = [&](int stretch_frames) {
     double sum = 0.0;
     for (int d = 0; d < options.floor_draws; ++d) {
-      const std::vector<GenSequence> stretches =
-          DrawRealStretches(windowed, frame_size, stretch_frames,
-                            options.generations, options.seed + 1000 + d);
+      // Among the sequences that hold a window, as the real windows are (a
+      // once-played kick of 46 frames holds none).
+      const std::vector<GenSequence> stretches = DrawRealStretches(
+          real.sequences, frame_size, stretch_frames, options.generations,
+          options.window_frames, options.seed + 1000 + d);
       sum += FrechetDistance(
           FitFeatureGaussian(EncodeWindows(encoder, windows_of(stretches))),
           real_gaussian);

@@ -150,26 +150,26 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
 
 std::vector<GenSequence> DrawRealStretches(
     const std::vector<GenSequence>& sequences, int frame_size,
-    int stretch_frames, int num_stretches, uint64_t seed) {
-  const bool any_frames =
-      std::any_of(sequences.begin(), sequences.end(),
-                  [](const GenSequence& s) { return s.num_frames > 0; });
-  if (!any_frames || stretch_frames < 1 || num_stretches < 1) {
-    throw ConfigError("cannot draw " + std::to_string(num_stretches) +
-                      " stretches of " + std::to_string(stretch_frames) +
-                      " from " + std::to_string(sequences.size()) +
-                      " sequences: " +
-                      (any_frames ? "count and length must be positive"
-                                  : "no sequence has frames"));
+    int stretch_frames, int num_stretches, int min_frames, uint64_t seed) {
+  std::vector<size_t> drawable;  // sequences of at least min_frames
+  for (size_t i = 0; i < sequences.size(); ++i)
+    if (sequences[i].num_frames >= std::max(1, min_frames))
+      drawable.push_back(i);
+  if (drawable.empty() || stretch_frames < 1 || num_stretches < 1) {
+    throw ConfigError(
+        "cannot draw " + std::to_string(num_stretches) + " stretches of " +
+        std::to_string(stretch_frames) + " from " +
+        std::to_string(sequences.size()) + " sequences: " +
+        (drawable.empty() ? "none has " + std::to_string(min_frames) + " frames"
+                          : "count and length must be positive"));
   }
   std::mt19937_64 random(seed);
-  std::uniform_int_distribution<size_t> pick(0, sequences.size() - 1);
+  std::uniform_int_distribution<size_t> pick(0, drawable.size() - 1);
   std::vector<GenSequence> stretches;
-  while (static_cast<int>(stretches.size()) < num_stretches) {
+  for (int k = 0; k < num_stretches; ++k) {
     // Outline: a sequence, a start that leaves a whole stretch when the
     // sequence holds one, the rows from there.
-    const GenSequence& sequence = sequences[pick(random)];
-    if (sequence.num_frames < 1) continue;
+    const GenSequence& sequence = sequences[drawable[pick(random)]];
     const int length = std::min(stretch_frames, sequence.num_frames);
     const int start = std::uniform_int_distribution<int>(
         0, sequence.num_frames - length)(random);

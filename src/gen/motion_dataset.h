@@ -106,15 +106,16 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
 // Stretches of real motion standing in for a generator's output, so that a
 // floor is measured on as many independent draws as there are
 // generations: `num_stretches` sequences drawn at random (with
-// replacement, `seed`), each read from a random start for up to
-// `stretch_frames` frames (all of a shorter one). Named "<name>@<start>".
-// A generator that replayed real motion would be scored on such draws: the
-// FID of their windows against all real windows is the floor it reaches
-// with this many generations. ConfigError on no frames to draw or a
-// non-positive count or length.
+// replacement, `seed`) among those of at least `min_frames` frames (a
+// feature window: shorter ones hold no window), each read from a random
+// start for up to `stretch_frames` frames (all of a shorter one). Named
+// "<name>@<start>". A generator that replayed real motion would be scored
+// on such draws: the FID of their windows against all real windows is the
+// floor it reaches with this many generations. ConfigError when no
+// sequence is long enough or on a non-positive count or length.
 std::vector<GenSequence> DrawRealStretches(
     const std::vector<GenSequence>& sequences, int frame_size,
-    int stretch_frames, int num_stretches, uint64_t seed);
+    int stretch_frames, int num_stretches, int min_frames, uint64_t seed);
 
 // Per-channel mean and std (floored) of every row of `sequences`.
 void FeatureStatistics(const std::vector<GenSequence>& sequences,

@@ -147,7 +147,7 @@ TEST(GenDataset, RealStretchesAreDrawnAsTheGenerationsWillBe) {
         sequences[k].features.push_back(static_cast<float>(100 * k + t));
   }
   const std::vector<GenSequence> stretches =
-      DrawRealStretches(sequences, frame_size, 10, 12, 7);
+      DrawRealStretches(sequences, frame_size, 10, 12, 1, 7);
   ASSERT_EQ(stretches.size(), 12u);
   bool saw[2] = {false, false};
   for (const GenSequence& stretch : stretches) {
@@ -163,12 +163,21 @@ TEST(GenDataset, RealStretchesAreDrawnAsTheGenerationsWillBe) {
   EXPECT_TRUE(saw[0] && saw[1]);
   // The same seed, the same draws.
   const std::vector<GenSequence> again =
-      DrawRealStretches(sequences, frame_size, 10, 12, 7);
+      DrawRealStretches(sequences, frame_size, 10, 12, 1, 7);
   ASSERT_EQ(again.size(), stretches.size());
   for (size_t i = 0; i < again.size(); ++i)
     EXPECT_EQ(again[i].name, stretches[i].name);
-  EXPECT_THROW(DrawRealStretches({}, frame_size, 10, 95, 7), ConfigError);
-  EXPECT_THROW(DrawRealStretches(sequences, frame_size, 0, 95, 7), ConfigError);
+  // Sequences shorter than min_frames are never drawn.
+  for (const GenSequence& stretch :
+       DrawRealStretches(sequences, frame_size, 10, 12, 9, 7))
+    EXPECT_LT(stretch.features[0], 100.0f) << stretch.name;
+  EXPECT_THROW(DrawRealStretches({}, frame_size, 10, 95, 1, 7), ConfigError);
+  EXPECT_THROW(DrawRealStretches(sequences, frame_size, 0, 95, 1, 7),
+               ConfigError);
+  EXPECT_THROW(DrawRealStretches(sequences, frame_size, 10, 0, 1, 7),
+               ConfigError);
+  EXPECT_THROW(DrawRealStretches(sequences, frame_size, 10, 12, 31, 7),
+               ConfigError);
 }
 
 }  // namespace
