@@ -180,6 +180,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   TrackingEnvOptions env_options = config.env;
   env_options.max_episode_s = args.seconds;
   const int root = character->root_qpos_address();
+  const GenConfig generator_config = ReadPriorConfig(args.run_dir);
   const std::vector<double> azimuths_deg =
       args.azimuths_deg.empty() ? std::vector<double>{args.view[0]}
                                 : args.azimuths_deg;
@@ -203,6 +204,8 @@ int RunTrackedGenerations(const GenerateArgs& args) {
       GeneratedStreamOptions stream_options;
       stream_options.sampling = args.sampling;
       stream_options.seed = args.seed + g;
+      stream_options.view =
+          GenerationView(generator_config, azimuth_deg, args.view[1]);
       stream_options.first_root_px = root_px;
       stream_options.first_scale_px = scale_px;
       stream_options.image_width_px = first_camera.intrinsics().width_px;
@@ -275,8 +278,19 @@ int RunGenerate(const GenerateArgs& args) {
                               !args.azimuths_deg.empty()))
     throw ConfigError(
         "generate: --video, --generations and --azimuths need --policy");
-  const GeneratedMotion motion =
-      GenerateMotion(args.run_dir, args.seconds, args.sampling, args.seed);
+  // A prior conditioned on the view generates the data's view nearest to
+  // --view.
+  const GenConfig config = ReadPriorConfig(args.run_dir);
+  const int view = GenerationView(config, args.view[0], args.view[1]);
+  if (view >= 0) {
+    std::printf(
+        "generating the data's view %d (azimuth %.0f deg, elevation "
+        "%.0f deg), the nearest to --view\n",
+        view, config.data.views.azimuth_deg(view),
+        config.data.views.elevation_deg(view));
+  }
+  const GeneratedMotion motion = GenerateMotion(args.run_dir, args.seconds,
+                                                args.sampling, args.seed, view);
   const int frames = motion.num_frames;
   const double fps = motion.fps;
 
@@ -348,6 +362,10 @@ int RunGenEval(const GenEvalArgs& args) {
         {"held_apart_windows", result.held_apart_windows},
         {"generated_windows", result.generated_windows},
         {"encoder_loss", result.encoder_loss},
+        {"drift_log_scale_generated", result.drift_log_scale_generated},
+        {"drift_log_scale_real", result.drift_log_scale_real},
+        {"drift_root_generated", result.drift_root_generated},
+        {"drift_root_real", result.drift_root_real},
         {"realtime_factor", result.realtime_factor}};
     WriteFileAtomic(args.output, json.dump(2) + "\n");
   }

@@ -113,7 +113,8 @@ LoadedPrior LoadPrior(const std::string& path) {
   torch::serialize::InputArchive archive = ReadArchiveFile(path, kPriorFormat);
   LoadedPrior loaded;
   loaded.config = ReadEmbeddedConfig(path, archive);
-  loaded.model = Gpt(loaded.config.tokenizer.num_codes, loaded.config.prior);
+  loaded.model = Gpt(loaded.config.tokenizer.num_codes, loaded.config.prior,
+                     loaded.config.prior_views());
   ReadModel(path, archive, *loaded.model);
   loaded.model->eval();
   return loaded;

@@ -103,6 +103,10 @@ struct GptOptions {
   // 1 - keep (T2M-GPT's corruption), so that sampling recovers from its own
   // unlikely draws.
   double keep_probability = 0.9;
+  // Every window opens with a token naming the view its sequence is seen
+  // from (T2M-GPT's slot 0, which holds its text): generation is asked for
+  // a view and cannot drift into another one.
+  bool condition_on_view = false;
   int batch_size = 64;
   double learning_rate = 2e-4;  // AdamW
   int64_t steps = 20000;
@@ -119,6 +123,8 @@ struct GptOptions {
     v("dropout", self.dropout, Range::Closed(0, 0.9), "dropout rate");
     v("keep_probability", self.keep_probability, Range::Closed(0, 1),
       "input tokens kept (others replaced by random codes)");
+    v("condition_on_view", self.condition_on_view, Range::Any(),
+      "windows open with a token naming the data's view");
     v("batch_size", self.batch_size, Range::Closed(1, 100000),
       "token windows per gradient step");
     v("learning_rate", self.learning_rate, Range::Above(0), "AdamW rate");
@@ -180,6 +186,11 @@ struct GenConfig {
   GptOptions prior;
   GenRunOptions run;
 
+  // View tokens of the prior's vocabulary: the data's views when it is
+  // conditioned on them, else 0.
+  int prior_views() const {
+    return prior.condition_on_view ? data.views.num_views() : 0;
+  }
   void Validate() const;  // throws ConfigError naming the setting
 };
 

@@ -126,9 +126,11 @@ torch::Tensor SampleWindows(const GenDataset& dataset, int window, int batch,
 std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
                                                   const GenDataset& dataset,
                                                   const torch::Tensor& mean,
-                                                  const torch::Tensor& std) {
+                                                  const torch::Tensor& std,
+                                                  std::vector<int>* views) {
   model->eval();
   std::vector<std::vector<int64_t>> sequences;
+  views->clear();
   const int per_token = model->frames_per_token();
   for (const GenSequence& sequence : dataset.sequences) {
     const int frames = sequence.num_frames / per_token * per_token;
@@ -140,6 +142,7 @@ std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
     torch::Tensor tokens = model->Encode((x - mean) / std).reshape({-1});
     sequences.emplace_back(tokens.data_ptr<int64_t>(),
                            tokens.data_ptr<int64_t>() + tokens.numel());
+    views->push_back(sequence.view);
   }
   model->train();
   return sequences;
@@ -298,11 +301,13 @@ double TrainTokenizer(const StageContext& context, bool resume, VqVae& model,
                   save);
 }
 
-// Trains `model` on windows of the token sequences up to prior.steps;
-// returns the last reported cross-entropy.
+// Trains `model` on windows of the token sequences (each seen from its
+// view of `views`) up to prior.steps; returns the last reported
+// cross-entropy.
 double TrainPrior(const StageContext& context, bool resume,
                   const std::vector<std::vector<int64_t>>& token_sequences,
-                  Gpt& model, GenStageState* state) {
+                  const std::vector<int>& views, Gpt& model,
+                  GenStageState* state) {
   const GptOptions& options = context.config.prior;
   const std::string path = context.RunFile(kPriorFile);
   torch::optim::AdamW optimizer(
@@ -323,8 +328,12 @@ double TrainPrior(const StageContext& context, bool resume,
                resume, state->step);
   // The last context of codes of every long sequence is held out: how far
   // the prior generalizes beyond memorizing the sequences it reads.
-  const TokenSplit split =
-      SplitTokensForValidation(token_sequences, options.context_tokens);
+  std::vector<int64_t> conditions;  // view tokens, for a conditioned prior
+  if (model->num_views() > 0) {
+    for (int view : views) conditions.push_back(model->view_token(view));
+  }
+  const TokenSplit split = SplitTokensForValidation(
+      token_sequences, options.context_tokens, conditions);
   TokenBatch batch;
   torch::Tensor logits, loss;
   model->train();
@@ -333,7 +342,7 @@ double TrainPrior(const StageContext& context, bool resume,
   auto step = [&] {
     batch = SampleTokenBatch(split.training, model->num_codes(),
                              options.context_tokens, options.batch_size,
-                             options.keep_probability, generator);
+                             options.keep_probability, generator, conditions);
     logits = model->forward(batch.inputs);
     loss = NextTokenLoss(logits, batch.targets);
     optimizer.zero_grad();
@@ -382,6 +391,12 @@ GenTrainSummary TrainGenerator(
     const std::function<void(const GenProgress&)>& on_progress) {
   if (dataset.sequences.empty())
     throw InputError(config.source_path, "the dataset has no sequences");
+  if (config.prior_views() > 0 && dataset.num_views != config.prior_views())
+    throw ConfigError("gen train: the dataset is seen from " +
+                      std::to_string(dataset.num_views) +
+                      " views but the config's data names " +
+                      std::to_string(config.prior_views()) +
+                      " (prior.condition_on_view needs them to agree)");
   torch::set_num_threads(config.run.torch_threads);
   std::filesystem::create_directories(config.run.run_dir);
   const StageContext context{config,
@@ -406,14 +421,15 @@ GenTrainSummary TrainGenerator(
     return summary;
   }
   // 2. Every sequence as codes.
+  std::vector<int> views;
   const std::vector<std::vector<int64_t>> token_sequences =
-      TokenizeDataset(tokenizer, dataset, context.mean, context.std);
+      TokenizeDataset(tokenizer, dataset, context.mean, context.std, &views);
   // 3. The prior, on the codes.
   torch::manual_seed(config.run.seed + 1);
-  Gpt prior(config.tokenizer.num_codes, config.prior);
+  Gpt prior(config.tokenizer.num_codes, config.prior, config.prior_views());
   GenStageState prior_state;
   summary.prior_loss =
-      TrainPrior(context, resume, token_sequences, prior, &prior_state);
+      TrainPrior(context, resume, token_sequences, views, prior, &prior_state);
   summary.prior_steps = prior_state.step;
   summary.interrupted = context.stop_requested();
   return summary;

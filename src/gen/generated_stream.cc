@@ -26,7 +26,8 @@ GeneratedStream::GeneratedStream(const std::string& run_dir,
   format_.image_height_px = options.image_height_px;
   stream_ = std::make_unique<MotionStream>(
       std::move(tokenizer), LoadPrior((run / kPriorFile).string()),
-      MotionStreamOptions{options.sampling, options.decoding, options.seed});
+      MotionStreamOptions{options.sampling, options.decoding, options.seed,
+                          options.view});
 }
 
 GeneratedStream::~GeneratedStream() = default;

@@ -21,6 +21,11 @@ GenConfig ReadGeneratorConfig(const std::string& run_dir) {
       .config;
 }
 
+GenConfig ReadPriorConfig(const std::string& run_dir) {
+  return LoadPrior((std::filesystem::path(run_dir) / kPriorFile).string())
+      .config;
+}
+
 namespace {
 
 // `seconds` of motion streamed from loaded models.
@@ -53,12 +58,18 @@ void CheckGeneration(double seconds, const SamplingOptions& sampling) {
 
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
                                const SamplingOptions& sampling, uint64_t seed,
-                               const StreamDecoding& decoding) {
+                               int view, const StreamDecoding& decoding) {
   CheckGeneration(seconds, sampling);
   const std::filesystem::path run(run_dir);
   return Generate(LoadTokenizer((run / kTokenizerFile).string()),
                   LoadPrior((run / kPriorFile).string()), seconds,
-                  {sampling, decoding, seed});
+                  {sampling, decoding, seed, view});
+}
+
+int GenerationView(const GenConfig& config, double azimuth_deg,
+                   double elevation_deg) {
+  if (config.prior_views() == 0) return -1;
+  return config.data.views.NearestView(azimuth_deg, elevation_deg);
 }
 
 std::string GeneratorEvalResult::BriefReport() const {
@@ -85,6 +96,10 @@ std::string GeneratorEvalResult::BriefReport() const {
     out << " (real stretches of a segment's length: "
         << fid_floor_sampled_segment << ")";
   out << "\n"
+      << "placement drift over a generation (RMS): log scale generated "
+      << drift_log_scale_generated << ", real " << drift_log_scale_real
+      << "; root generated " << drift_root_generated << ", real "
+      << drift_root_real << " body scales\n"
       << "generation speed " << realtime_factor
       << "x real time (1 thread, tokens + decoding)\n";
   return out.str();
@@ -200,9 +215,11 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   CheckGeneration(options.seconds, options.sampling);
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
-    GeneratedMotion motion = Generate(
-        tokenizer, prior, options.seconds,
-        {options.sampling, options.decoding, static_cast<uint64_t>(g + 1)});
+    const int views = prior.config.prior_views();
+    GeneratedMotion motion =
+        Generate(tokenizer, prior, options.seconds,
+                 {options.sampling, options.decoding,
+                  static_cast<uint64_t>(g + 1), views > 0 ? g % views : -1});
     generation_s += motion.generation_s;
     generated_s += motion.num_frames / motion.fps;
     generated.push_back({"generated/" + std::to_string(g + 1),
@@ -216,6 +233,24 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       EncodeWindows(encoder, generated_windows);
 
   // 4. The figures.
+  auto rms_drift = [&](const std::vector<GenSequence>& sequences,
+                       double* log_scale, double* root) {
+    double scale_sum = 0.0, root_sum = 0.0;
+    for (const GenSequence& sequence : sequences) {
+      const PlacementDrift drift = PlacementDriftOf(sequence, frame_size);
+      scale_sum += drift.log_scale_change * drift.log_scale_change;
+      root_sum += drift.root_displacement.squaredNorm();
+    }
+    const double count = std::max<size_t>(1, sequences.size());
+    *log_scale = std::sqrt(scale_sum / count);
+    *root = std::sqrt(root_sum / count);
+  };
+  rms_drift(generated, &result.drift_log_scale_generated,
+            &result.drift_root_generated);
+  rms_drift(DrawRealStretches(real.sequences, frame_size, generation_frames,
+                              options.generations, options.window_frames,
+                              options.seed + 1000),
+            &result.drift_log_scale_real, &result.drift_root_real);
   result.fid =
       FrechetDistance(FitFeatureGaussian(generated_features), real_gaussian);
   result.diversity_real = MeanPairDistance(real_features, 300, options.seed);

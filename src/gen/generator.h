@@ -17,6 +17,10 @@ namespace m2d {
 // The config a generator run was trained with (embedded in its
 // tokenizer.pt). InputError naming the file when it cannot be read.
 GenConfig ReadGeneratorConfig(const std::string& run_dir);
+// The config its prior was trained with (prior.pt's): the same data and
+// tokenizer, and the prior's own settings, which a prior retrained on a
+// kept tokenizer may have changed.
+GenConfig ReadPriorConfig(const std::string& run_dir);
 
 struct GeneratedMotion {
   std::vector<float> rows;  // num_frames rows of X^can (CanonicalFeatures)
@@ -27,13 +31,25 @@ struct GeneratedMotion {
 };
 
 // `seconds` of motion streamed from the run's prior and tokenizer
-// (gen/motion_stream.h), with `sampling` and `seed`.
+// (gen/motion_stream.h), with `sampling` and `seed`; `view`: which of the
+// data's views a prior conditioned on the view generates (-1 for one that
+// is not; GenerationView picks it).
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
                                const SamplingOptions& sampling, uint64_t seed,
+                               int view = -1,
                                const StreamDecoding& decoding = {});
 
+// The data view a run's prior generates for a camera at `azimuth_deg`,
+// `elevation_deg`: the nearest of its views when it is conditioned on the
+// view, else -1.
+int GenerationView(const GenConfig& config, double azimuth_deg,
+                   double elevation_deg);
+
 struct GeneratorEvalOptions {
-  int generations = 10;   // independent streams (seeds 1..N)
+  // Independent streams (seeds 1..N); a prior conditioned on the view
+  // generates generation g in view g mod V, as evenly as the data holds
+  // its views.
+  int generations = 10;
   double seconds = 60.0;  // per generation
   SamplingOptions sampling;
   StreamDecoding decoding;
@@ -80,6 +96,13 @@ struct GeneratorEvalResult {
   // part of every generation; equal window counts, so comparable with each
   // other, not with `fid`, which has more windows and less bias).
   std::vector<double> fid_by_time_segment;
+  // Placement drift over a generation (PlacementDriftOf), root mean square
+  // over the generations, and over as many real stretches of the same
+  // length: the change of log scale, and the root's displacement (units of
+  // the first frame's scale). The FID's windows see steps, not where they
+  // add up to; a tracker behind a following camera sees the sum.
+  double drift_log_scale_generated = 0.0, drift_log_scale_real = 0.0;
+  double drift_root_generated = 0.0, drift_root_real = 0.0;
   double realtime_factor = 0.0;  // generated seconds per second of CPU
                                  // time, one LibTorch thread
   std::string BriefReport() const;

@@ -80,11 +80,12 @@ torch::Tensor CausalBlockImpl::Step(const torch::Tensor& x, torch::Tensor* keys,
   return y + mlp_out_->forward(m);
 }
 
-GptImpl::GptImpl(int num_codes, const GptOptions& options)
-    : num_codes_(num_codes), options_(options) {
+GptImpl::GptImpl(int num_codes, const GptOptions& options, int num_views)
+    : num_codes_(num_codes), num_views_(num_views), options_(options) {
   const int embedding = options.embedding;
   token_embedding_ = register_module(
-      "token_embedding", torch::nn::Embedding(num_codes + 1, embedding));
+      "token_embedding",
+      torch::nn::Embedding(num_codes + 1 + num_views, embedding));
   position_embedding_ = register_parameter(
       "position_embedding", torch::zeros({options.context_tokens, embedding}));
   for (int i = 0; i < options.num_layers; ++i) {
@@ -147,9 +148,15 @@ torch::Tensor GptImpl::ForwardCached(const torch::Tensor& tokens,
 TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
                             int num_codes, int context, int batch_size,
                             double keep_probability,
-                            torch::Generator& generator) {
+                            torch::Generator& generator,
+                            const std::vector<int64_t>& conditions) {
   TORCH_CHECK(!sequences.empty(), "no token sequences to sample from");
+  TORCH_CHECK(conditions.empty() || conditions.size() == sequences.size(),
+              "one condition per token sequence");
   const int64_t start = num_codes;
+  // Slot 0 holds the condition; the read sequence fills the rest.
+  const int64_t slots = conditions.empty() ? 0 : 1;
+  const int64_t span = context - slots;
   torch::Tensor inputs = torch::zeros({batch_size, context}, torch::kLong);
   torch::Tensor targets =
       torch::full({batch_size, context}, kIgnoreTarget, torch::kLong);
@@ -157,24 +164,28 @@ TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
     return torch::randint(bound, {1}, generator, torch::kLong).item<int64_t>();
   };
   for (int b = 0; b < batch_size; ++b) {
-    const std::vector<int64_t>& codes =
-        sequences[draw(static_cast<int64_t>(sequences.size()))];
+    const int64_t drawn = draw(static_cast<int64_t>(sequences.size()));
+    const std::vector<int64_t>& codes = sequences[drawn];
     // The read sequence [start, c_0, ..., c_{n-1}] has n + 1 tokens; a
-    // window of `context` inputs predicts the token after each of them.
+    // window of `span` of them predicts the token after each of them.
     const int64_t read_length = static_cast<int64_t>(codes.size()) + 1;
-    const int64_t offset = draw(std::max<int64_t>(1, read_length - context));
+    const int64_t offset = draw(std::max<int64_t>(1, read_length - span));
     auto token_at = [&](int64_t i) { return i == 0 ? start : codes[i - 1]; };
     int64_t* input = inputs[b].data_ptr<int64_t>();
     int64_t* target = targets[b].data_ptr<int64_t>();
-    for (int64_t s = 0; s < context && offset + s + 1 < read_length; ++s) {
-      input[s] = token_at(offset + s);
-      target[s] = token_at(offset + s + 1);
+    if (slots > 0) {
+      input[0] = conditions[drawn];
+      if (offset > 0) target[0] = token_at(offset);
+    }
+    for (int64_t s = 0; s < span && offset + s + 1 < read_length; ++s) {
+      input[slots + s] = token_at(offset + s);
+      target[slots + s] = token_at(offset + s + 1);
     }
   }
   if (keep_probability < 1.0) {
     torch::Tensor corrupt =
         torch::rand({batch_size, context}, generator) >= keep_probability;
-    corrupt = corrupt.logical_and(inputs != start);
+    corrupt = corrupt.logical_and(inputs < start);  // codes only
     inputs = torch::where(corrupt,
                           torch::randint(num_codes, {batch_size, context},
                                          generator, torch::kLong),
@@ -184,24 +195,28 @@ TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
 }
 
 TokenSplit SplitTokensForValidation(
-    const std::vector<std::vector<int64_t>>& sequences, int context) {
+    const std::vector<std::vector<int64_t>>& sequences, int context,
+    const std::vector<int64_t>& conditions) {
+  TORCH_CHECK(conditions.empty() || conditions.size() == sequences.size(),
+              "one condition per token sequence");
   TokenSplit split;
   std::vector<torch::Tensor> inputs, targets;
-  for (const std::vector<int64_t>& codes : sequences) {
+  for (size_t i = 0; i < sequences.size(); ++i) {
+    const std::vector<int64_t>& codes = sequences[i];
     const int64_t n = static_cast<int64_t>(codes.size());
     if (n < 2 * context + 1) {
       split.training.push_back(codes);
       continue;
     }
     split.training.emplace_back(codes.begin(), codes.end() - context);
-    const int64_t* data = codes.data();
-    inputs.push_back(
-        torch::from_blob(const_cast<int64_t*>(data + n - context - 1),
-                         {context}, torch::kLong)
-            .clone());
-    targets.push_back(torch::from_blob(const_cast<int64_t*>(data + n - context),
-                                       {context}, torch::kLong)
-                          .clone());
+    // Inputs: the code before the held-out ones (or the condition) and all
+    // but the last of them.
+    std::vector<int64_t> input(codes.end() - context - 1, codes.end() - 1);
+    if (!conditions.empty()) input.front() = conditions[i];
+    inputs.push_back(torch::tensor(input, torch::kLong));
+    targets.push_back(
+        torch::tensor(std::vector<int64_t>(codes.end() - context, codes.end()),
+                      torch::kLong));
   }
   if (!inputs.empty()) {
     split.validation.inputs = torch::stack(inputs);
@@ -217,16 +232,32 @@ torch::Tensor NextTokenLoss(const torch::Tensor& logits,
       F::CrossEntropyFuncOptions().ignore_index(kIgnoreTarget));
 }
 
-TokenSampler::TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed)
+TokenSampler::TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed,
+                           int view)
     : gpt_(std::move(gpt)),
       options_(options),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)) {
   options_.Validate();
-  if (options_.kept_context_tokens >= gpt_->context_tokens())
+  if (gpt_->num_views() > 0) {
+    if (view < 0 || view >= gpt_->num_views())
+      throw ConfigError("sampling: the prior is conditioned on " +
+                        std::to_string(gpt_->num_views()) + " views; view " +
+                        std::to_string(view) + " is not one of them");
+    condition_.push_back(gpt_->view_token(view));
+  } else if (view >= 0) {
+    throw ConfigError("sampling: view " + std::to_string(view) +
+                      " asked of a prior not conditioned on the view");
+  }
+  // The codes one attention window holds after the condition.
+  const int code_context =
+      gpt_->context_tokens() - static_cast<int>(condition_.size());
+  kept_codes_ = options_.kept_context_tokens > 0 ? options_.kept_context_tokens
+                                                 : gpt_->context_tokens() / 2;
+  if (kept_codes_ >= code_context)
     throw ConfigError("sampling: kept_context_tokens " +
-                      std::to_string(options_.kept_context_tokens) +
+                      std::to_string(kept_codes_) +
                       " must be below the prior's context of " +
-                      std::to_string(gpt_->context_tokens()) + " codes");
+                      std::to_string(code_context) + " codes");
   history_.push_back(gpt_->start_token());
 }
 
@@ -239,19 +270,17 @@ int64_t TokenSampler::Next() {
   const int64_t context = gpt_->context_tokens();
   torch::Tensor logits;
   if (cache_.length == 0 || cache_.length == context) {
-    // A restart: the kept codes (all of a short history).
-    const int64_t kept = options_.kept_context_tokens > 0
-                             ? options_.kept_context_tokens
-                             : context / 2;
-    const int64_t keep =
-        std::min<int64_t>(static_cast<int64_t>(history_.size()),
-                          cache_.length == context ? kept : context);
+    // A restart: the condition and the kept codes (all of a short
+    // history).
+    const int64_t keep = std::min<int64_t>(
+        static_cast<int64_t>(history_.size()),
+        cache_.length == context
+            ? kept_codes_
+            : context - static_cast<int64_t>(condition_.size()));
+    std::vector<int64_t> tokens = condition_;
+    tokens.insert(tokens.end(), history_.end() - keep, history_.end());
     cache_ = GptCache();
-    logits = gpt_->ForwardCached(
-        torch::tensor(
-            std::vector<int64_t>(history_.end() - keep, history_.end()),
-            torch::kLong),
-        &cache_);
+    logits = gpt_->ForwardCached(torch::tensor(tokens, torch::kLong), &cache_);
   } else {
     logits = gpt_->ForwardCached(
         torch::tensor(std::vector<int64_t>{history_.back()}, torch::kLong),

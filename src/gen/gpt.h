@@ -46,8 +46,10 @@ struct GptCache {
 
 class GptImpl : public torch::nn::Module {
  public:
-  // Vocabulary: the K codes and a start token (K) that opens a sequence.
-  GptImpl(int num_codes, const GptOptions& options);
+  // Vocabulary: the K codes, a start token (K) that opens a sequence and,
+  // for a prior conditioned on the view, `num_views` view tokens (K + 1 +
+  // v), one of which opens every window.
+  GptImpl(int num_codes, const GptOptions& options, int num_views = 0);
 
   // tokens: [B, S] int64 in [0, K], S <= context_tokens -> logits over the
   // K codes [B, S, K] for each next token.
@@ -60,10 +62,13 @@ class GptImpl : public torch::nn::Module {
 
   int num_codes() const { return num_codes_; }
   int64_t start_token() const { return num_codes_; }
+  int num_views() const { return num_views_; }
+  int64_t view_token(int view) const { return num_codes_ + 1 + view; }
   int context_tokens() const { return options_.context_tokens; }
 
  private:
   int num_codes_;
+  int num_views_;
   GptOptions options_;
   torch::nn::Embedding token_embedding_{nullptr};
   torch::Tensor position_embedding_;  // [context, E], learned
@@ -86,34 +91,46 @@ struct TokenBatch {
 // without the start token teach the sliding context of endless generation)
 // and is padded when the sequence is shorter. With probability 1 −
 // keep_probability an input code is replaced by a random code.
+// `conditions` (empty, or one token per sequence: its view token) opens
+// every window of its sequence in slot 0, followed by context − 1 tokens
+// of the read sequence; slot 0 predicts the first of them (nothing when
+// that is the start token).
 TokenBatch SampleTokenBatch(const std::vector<std::vector<int64_t>>& sequences,
                             int num_codes, int context, int batch_size,
                             double keep_probability,
-                            torch::Generator& generator);
+                            torch::Generator& generator,
+                            const std::vector<int64_t>& conditions = {});
 
 // The prior's held-out data: every sequence long enough (at least
 // 2 * context + 1 codes) keeps its last `context` codes apart. `validation`
 // holds one window per such sequence whose targets are exactly those codes
 // (inputs: the code before them and all but the last of them; undefined
 // tensors when no sequence is long enough); `training` is every sequence
-// without its held-out codes, so no held-out code is ever an input or a
-// target of training.
+// without its held-out codes, in order, so no held-out code is ever an
+// input or a target of training. With `conditions` (as SampleTokenBatch
+// takes them) a window's inputs are the sequence's condition and all but
+// the last held-out code.
 struct TokenSplit {
   std::vector<std::vector<int64_t>> training;
   TokenBatch validation;
 };
 TokenSplit SplitTokensForValidation(
-    const std::vector<std::vector<int64_t>>& sequences, int context);
+    const std::vector<std::vector<int64_t>>& sequences, int context,
+    const std::vector<int64_t>& conditions = {});
 
 // Mean next-token cross-entropy (nats) of a batch.
 torch::Tensor NextTokenLoss(const torch::Tensor& logits,
                             const torch::Tensor& targets);
 
 // Endless sampling: the history starts with the start token; each step
-// attends to the last context_tokens tokens of it.
+// attends to the last context_tokens tokens of it (after the view token,
+// for a prior conditioned on the view).
 class TokenSampler {
  public:
-  TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed);
+  // `view`: which of the data's views to generate (a conditioned prior
+  // needs one in [0, num_views); an unconditioned one takes -1).
+  // ConfigError otherwise.
+  TokenSampler(Gpt gpt, SamplingOptions options, uint64_t seed, int view = -1);
   int64_t Next();  // draws, appends and returns the next code
   const std::vector<int64_t>& codes() const { return codes_; }
 
@@ -123,6 +140,8 @@ class TokenSampler {
   torch::Generator generator_;
   std::vector<int64_t> history_;  // start token, then the codes
   std::vector<int64_t> codes_;
+  std::vector<int64_t> condition_;  // the view token, or nothing
+  int kept_codes_ = 0;              // codes kept when the context slides
   // The keys and values of the attended tokens (the tail of history_).
   // When the context is full, it restarts from its last half: each code
   // attends to between half the context and all of it, as training windows

@@ -83,6 +83,36 @@ CanonicalClip CanonicalFromFeatures(const float* rows, int num_frames,
   return canonical;
 }
 
+double GenViewOptions::azimuth_deg(int view) const {
+  return RigOptions().first_azimuth_deg +
+         (view % num_azimuths) * 360.0 / num_azimuths;
+}
+
+double GenViewOptions::elevation_deg(int view) const {
+  return elevations_deg.at(view / num_azimuths);
+}
+
+int GenViewOptions::NearestView(double azimuth_deg,
+                                double elevation_deg) const {
+  auto direction = [](double azimuth, double elevation) {
+    const double a = azimuth * M_PI / 180.0, e = elevation * M_PI / 180.0;
+    return Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a),
+                           std::sin(e));
+  };
+  const Eigen::Vector3d wanted = direction(azimuth_deg, elevation_deg);
+  int nearest = 0;
+  double best_cosine = -2.0;
+  for (int v = 0; v < num_views(); ++v) {
+    const double cosine =
+        wanted.dot(direction(this->azimuth_deg(v), this->elevation_deg(v)));
+    if (cosine > best_cosine + 1e-12) {
+      best_cosine = cosine;
+      nearest = v;
+    }
+  }
+  return nearest;
+}
+
 void GenViewOptions::Validate() const {
   if (num_azimuths < 1 || num_azimuths > 360)
     throw ConfigError("views: num_azimuths must be in [1, 360]");
@@ -115,7 +145,8 @@ GenSequence FramesOf(const GenSequence& sequence, int frame_size, int begin,
   return {std::move(name),
           end - begin,
           {rows + static_cast<size_t>(begin) * frame_size,
-           rows + static_cast<size_t>(end) * frame_size}};
+           rows + static_cast<size_t>(end) * frame_size},
+          sequence.view};
 }
 
 }  // namespace
@@ -146,6 +177,21 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
   halves[0].name = sequence.name + "/first";
   halves[1].name = sequence.name + "/second";
   return {std::move(halves[0]), std::move(halves[1])};
+}
+
+PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size) {
+  // Row layout (CanonicalFeatures): local pose, then the root step (2),
+  // then the log-scale step (1).
+  const int root = frame_size - 3, log_scale = frame_size - 1;
+  PlacementDrift drift;
+  for (int t = 1; t < sequence.num_frames; ++t) {
+    const float* row =
+        sequence.features.data() + static_cast<size_t>(t) * frame_size;
+    drift.log_scale_change += row[log_scale];
+    drift.root_displacement += std::exp(drift.log_scale_change) *
+                               Eigen::Vector2d(row[root], row[root + 1]);
+  }
+  return drift;
 }
 
 std::vector<GenSequence> DrawRealStretches(
@@ -214,7 +260,9 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
   GenDataset dataset;
   dataset.fps = fps;
   dataset.frame_size = CanonicalFrameSize(*dataset.layout);
+  dataset.num_views = views.num_views();
   for (const GenMotionSource& source : motions) {
+    int view_index = 0;  // the order of GenViewOptions::azimuth_deg
     for (double elevation : views.elevations_deg) {
       BundleFromMotionOptions options;
       options.fps = fps;
@@ -237,6 +285,7 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
             std::to_string(static_cast<int>(std::lround(elevation)));
         sequence.num_frames = canonical.num_frames();
         sequence.features = CanonicalFeatures(canonical);
+        sequence.view = view_index++;
         dataset.sequences.push_back(std::move(sequence));
       }
     }

@@ -51,6 +51,14 @@ struct GenViewOptions {
   int num_views() const {
     return num_azimuths * static_cast<int>(elevations_deg.size());
   }
+  // The data's views in order (view v: elevation v / num_azimuths, azimuth
+  // v % num_azimuths): azimuth of view k of an elevation (deg; the rig's,
+  // camera/rig.h, from its first azimuth).
+  double azimuth_deg(int view) const;
+  double elevation_deg(int view) const;
+  // The view nearest to a camera at `azimuth_deg`, `elevation_deg`
+  // (angular distance of the directions to the subject).
+  int NearestView(double azimuth_deg, double elevation_deg) const;
   void Validate() const;  // throws ConfigError
 };
 
@@ -66,12 +74,14 @@ struct GenSequence {
   std::string name;  // "<motion>/<view>"
   int num_frames = 0;
   std::vector<float> features;  // num_frames rows of CanonicalFrameSize
+  int view = 0;  // which of GenViewOptions' views it is seen from
 };
 
 struct GenDataset {
   const KeypointLayout* layout = &Coco17Layout();
   double fps = 30.0;
   int frame_size = 0;
+  int num_views = 0;  // the GenViewOptions it was seen from
   std::vector<GenSequence> sequences;
   // Per-channel statistics over every frame, for normalization; std has a
   // floor (kMinFeatureStd) so that a constant channel does not blow up.
@@ -116,6 +126,19 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
 std::vector<GenSequence> DrawRealStretches(
     const std::vector<GenSequence>& sequences, int frame_size,
     int stretch_frames, int num_stretches, int min_frames, uint64_t seed);
+
+// How far a sequence's placement moves from its first frame: the change of
+// log scale, log(s_end / s_0) (the sum of the log-scale steps), and the
+// root's displacement in units of the first frame's scale (each root step
+// times its frame's scale). The first row's steps (from before the
+// sequence) are not counted. A camera that follows the subject, as the
+// data's do, keeps both near 0; a generator whose steps are biased drifts,
+// and a tracker behind a following camera cannot follow that.
+struct PlacementDrift {
+  double log_scale_change = 0.0;
+  Eigen::Vector2d root_displacement = Eigen::Vector2d::Zero();
+};
+PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size);
 
 // Per-channel mean and std (floored) of every row of `sequences`.
 void FeatureStatistics(const std::vector<GenSequence>& sequences,

@@ -9,7 +9,7 @@ namespace m2d {
 MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                            const MotionStreamOptions& options)
     : tokenizer_(std::move(tokenizer)),
-      sampler_(prior.model, options.sampling, options.seed),
+      sampler_(prior.model, options.sampling, options.seed, options.view),
       options_(options) {
   if (prior.model->num_codes() != tokenizer_.model->num_codes()) {
     throw ConfigError("the prior predicts " +

@@ -16,6 +16,7 @@ struct MotionStreamOptions {
   SamplingOptions sampling;
   StreamDecoding decoding;
   uint64_t seed = 1;
+  int view = -1;  // the data's view to generate (a conditioned prior's)
 };
 
 // Each Next() emits one code's frames. Frames are decoded for

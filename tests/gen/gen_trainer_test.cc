@@ -216,6 +216,12 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_TRUE(std::isfinite(short_result.fid_floor_sampled));
   EXPECT_EQ(short_result.real_windows, result.real_windows);
   EXPECT_GT(result.diversity_generated, 0.0);
+  for (double drift :
+       {result.drift_log_scale_generated, result.drift_log_scale_real,
+        result.drift_root_generated, result.drift_root_real}) {
+    EXPECT_TRUE(std::isfinite(drift));
+    EXPECT_GE(drift, 0.0);
+  }
   EXPECT_GT(result.realtime_factor, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));
   ASSERT_EQ(result.fid_by_time_segment.size(), 2u);
@@ -235,6 +241,51 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_THROW(
       GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.0, 0}, 4),
       ConfigError);
+}
+
+TEST(GenTrainer, AViewConditionedPriorGeneratesTheViewAskedFor) {
+  // The walk from 2 azimuths (30 and 210 deg) at 10 deg: a prior
+  // conditioned on the view has a token for each, generation asks for
+  // one, and a view it does not have is refused.
+  GenConfig config = TinyConfig(TempRun("view"));
+  config.prior.condition_on_view = true;
+  // A dataset seen from views the config does not name is refused.
+  EXPECT_THROW(TrainGenerator(config, WalkDataset(), false, nullptr, nullptr),
+               ConfigError);
+  config.data.views.num_azimuths = 2;  // WalkDataset's views
+  config.data.views.elevations_deg = {10};
+  TrainGenerator(config, WalkDataset(), false, nullptr, nullptr);
+  const LoadedPrior prior = LoadPrior(config.run.run_dir + "/prior.pt");
+  EXPECT_EQ(prior.model->num_views(), 2);
+  EXPECT_EQ(ReadPriorConfig(config.run.run_dir).prior_views(), 2);
+  EXPECT_EQ(GenerationView(config, 200, 0), 1);
+  EXPECT_EQ(GenerationView(config, 30, 40), 0);
+  EXPECT_EQ(GenerationView(TinyConfig("unconditioned"), 200, 0), -1);
+  const SamplingOptions sampling{1.0, 0};
+  const GeneratedMotion motion =
+      GenerateMotion(config.run.run_dir, 2.0, sampling, 3, /*view=*/1);
+  EXPECT_EQ(motion.num_frames, 60);
+  for (float value : motion.rows) ASSERT_TRUE(std::isfinite(value));
+  EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, sampling, 3),
+               ConfigError);
+  EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, sampling, 3, 2),
+               ConfigError);
+  GeneratedStreamOptions stream_options;
+  stream_options.view = 0;
+  GeneratedStream stream(config.run.run_dir, stream_options);
+  std::vector<Keypoint2D> frame;
+  for (int t = 0; t < 40; ++t) ASSERT_TRUE(stream.Next(&frame));
+  // The evaluation generates every view in turn.
+  GeneratorEvalOptions options;
+  options.generations = 2;
+  options.seconds = 2.0;
+  options.window_frames = 16;
+  options.stride_frames = 8;
+  options.encoder_steps = 10;
+  options.time_segments = 1;
+  EXPECT_TRUE(std::isfinite(EvaluateGenerator(config.run.run_dir, WalkDataset(),
+                                              WalkDataset(), options)
+                                .fid));
 }
 
 TEST(GenTrainer, ADamagedCheckpointIsNamed) {

@@ -87,6 +87,108 @@ TEST(Gpt, BatchesReadSequencesFromTheirStart) {
                                            kIgnoreTarget, kIgnoreTarget}));
 }
 
+TEST(Gpt, ConditionedWindowsOpenWithTheirView) {
+  auto generator = at::make_generator<at::CPUGeneratorImpl>(1);
+  // Slot 0 holds the view token (20); the read sequence follows, so the
+  // first window of {4, 5, 6} is [20, start, 4, 5, pad, pad]; slot 0
+  // predicts nothing there (the start token is not a code).
+  TokenBatch batch =
+      SampleTokenBatch({{4, 5, 6}}, 8, 6, 2, 1.0, generator, {20});
+  std::vector<int64_t> inputs(batch.inputs[0].data_ptr<int64_t>(),
+                              batch.inputs[0].data_ptr<int64_t>() + 6);
+  std::vector<int64_t> targets(batch.targets[0].data_ptr<int64_t>(),
+                               batch.targets[0].data_ptr<int64_t>() + 6);
+  EXPECT_EQ(inputs, (std::vector<int64_t>{20, 8, 4, 5, 0, 0}));
+  EXPECT_EQ(targets, (std::vector<int64_t>{kIgnoreTarget, 4, 5, 6,
+                                           kIgnoreTarget, kIgnoreTarget}));
+  // Mid-sequence windows: slot 0 predicts the window's first code. Each
+  // sequence gets its own view; corruption never touches the view or the
+  // start token.
+  std::vector<std::vector<int64_t>> sequences = {{}, {}};
+  for (int64_t i = 0; i < 40; ++i) {
+    sequences[0].push_back(i % 4);
+    sequences[1].push_back(4 + i % 4);
+  }
+  batch = SampleTokenBatch(sequences, 8, 6, 64, 1.0, generator, {9, 10});
+  int mid_windows = 0;
+  for (int b = 0; b < 64; ++b) {
+    const int64_t view = batch.inputs[b][0].item<int64_t>();
+    ASSERT_TRUE(view == 9 || view == 10);
+    const int64_t first = batch.inputs[b][1].item<int64_t>();
+    if (first == 8) continue;  // the start: slot 0 predicts nothing
+    ++mid_windows;
+    EXPECT_EQ(batch.targets[b][0].item<int64_t>(), first);
+    EXPECT_EQ(first / 4, view - 9);  // the view's own sequence
+  }
+  EXPECT_GT(mid_windows, 40);
+  torch::Tensor corrupted =
+      SampleTokenBatch(sequences, 8, 6, 64, 0.0, generator, {9, 10}).inputs;
+  EXPECT_TRUE(corrupted.select(1, 0).ge(9).all().item<bool>());
+  // Sequences and conditions must pair up.
+  EXPECT_THROW(SampleTokenBatch(sequences, 8, 6, 1, 1.0, generator, {9}),
+               c10::Error);
+}
+
+TEST(Gpt, AConditionedPriorGeneratesTheViewItIsAskedFor) {
+  // View 0 cycles through codes 0..3, view 1 through 4..7, from every
+  // phase. Asked for a view, the prior draws its codes from the first one
+  // on (an unconditioned prior's first code would be either view's) and
+  // keeps to them past the context.
+  torch::manual_seed(4);
+  torch::set_num_threads(1);
+  GptOptions options = SmallGpt();
+  options.condition_on_view = true;
+  Gpt gpt(8, options, /*num_views=*/2);
+  torch::optim::AdamW optimizer(gpt->parameters(),
+                                torch::optim::AdamWOptions(3e-3));
+  std::vector<std::vector<int64_t>> sequences;
+  std::vector<int64_t> conditions;
+  for (int view = 0; view < 2; ++view) {
+    for (int phase = 0; phase < 4; ++phase) {
+      std::vector<int64_t> codes;
+      for (int i = 0; i < 40; ++i) codes.push_back(4 * view + (i + phase) % 4);
+      sequences.push_back(codes);
+      conditions.push_back(gpt->view_token(view));
+    }
+  }
+  auto generator = at::make_generator<at::CPUGeneratorImpl>(5);
+  for (int step = 0; step < 300; ++step) {
+    TokenBatch batch =
+        SampleTokenBatch(sequences, 8, options.context_tokens, 16,
+                         options.keep_probability, generator, conditions);
+    torch::Tensor l = NextTokenLoss(gpt->forward(batch.inputs), batch.targets);
+    optimizer.zero_grad();
+    l.backward();
+    optimizer.step();
+  }
+  torch::NoGradGuard no_grad;
+  gpt->eval();
+  for (int view = 0; view < 2; ++view) {
+    // The first code: the 4 likeliest are the view's 4.
+    GptCache cache;
+    const torch::Tensor first = gpt->ForwardCached(
+        torch::tensor({gpt->view_token(view), gpt->start_token()}), &cache);
+    const torch::Tensor likeliest =
+        std::get<0>(std::get<1>(first.topk(4)).sort());
+    EXPECT_TRUE(likeliest.equal(torch::arange(4 * view, 4 * view + 4)))
+        << "view " << view;
+    // Then the view's cycle, past the context of 12.
+    TokenSampler sampler(gpt, SamplingOptions{1.0, 1}, 1, view);
+    int64_t previous = sampler.Next();
+    for (int i = 1; i < 40; ++i) {
+      const int64_t code = sampler.Next();
+      ASSERT_EQ(code, 4 * view + (previous + 1) % 4) << "code " << i;
+      previous = code;
+    }
+  }
+  // A view it does not know, or none, is refused; so is a view asked of an
+  // unconditioned prior.
+  EXPECT_THROW(TokenSampler(gpt, SamplingOptions(), 1, 2), ConfigError);
+  EXPECT_THROW(TokenSampler(gpt, SamplingOptions(), 1), ConfigError);
+  EXPECT_THROW(TokenSampler(Gpt(8, SmallGpt()), SamplingOptions(), 1, 0),
+               ConfigError);
+}
+
 TEST(Gpt, LearnsACycleAndContinuesItEndlessly) {
   // Codes 0..5 repeating: after training, greedy sampling must continue the
   // cycle far past the context (the sliding window starts mid-cycle).
@@ -145,6 +247,14 @@ TEST(Gpt, HeldOutCodesAreNeverTrainedOn) {
       torch::tensor({8, 9, 10, 11}, torch::kLong)));
   EXPECT_TRUE(split.validation.inputs[0].equal(
       torch::tensor({7, 8, 9, 10}, torch::kLong)));
+  // Conditioned: the view token takes the place of the code before them.
+  const TokenSplit conditioned =
+      SplitTokensForValidation(sequences, context, {30, 31});
+  EXPECT_EQ(conditioned.training, split.training);
+  EXPECT_TRUE(conditioned.validation.targets[0].equal(
+      torch::tensor({8, 9, 10, 11}, torch::kLong)));
+  EXPECT_TRUE(conditioned.validation.inputs[0].equal(
+      torch::tensor({30, 8, 9, 10}, torch::kLong)));
   // Nothing long enough: no validation batch.
   EXPECT_FALSE(SplitTokensForValidation({{1, 2, 3}}, context)
                    .validation.inputs.defined());

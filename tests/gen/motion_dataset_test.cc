@@ -80,6 +80,60 @@ TEST(GenDataset, EveryMotionIsSeenFromEveryView) {
   double difference = 0;
   for (int c = 0; c < 34; ++c) difference += std::abs(a[c] - b[c]);
   EXPECT_GT(difference, 0.5);
+  // Each sequence knows its view: elevation-major, the rig's azimuth order.
+  for (int v = 0; v < 6; ++v) {
+    EXPECT_EQ(dataset.sequences[v].view, v);
+    const std::string suffix = "/view" + std::to_string(v % 3) + "_el" +
+                               (v < 3 ? std::string("0") : std::string("25"));
+    const std::string& name = dataset.sequences[v].name;
+    EXPECT_EQ(name.substr(name.size() - suffix.size()), suffix);
+  }
+  // Cut or drawn, a sequence keeps its view.
+  EXPECT_EQ(CutSequenceInTime(dataset.sequences[4], 37, 3)[2].view, 4);
+  EXPECT_EQ(DrawRealStretches({dataset.sequences[5]}, 37, 30, 1, 1, 1)[0].view,
+            5);
+}
+
+TEST(GenDataset, AskedForACameraTheNearestViewAnswers) {
+  GenViewOptions views;
+  views.num_azimuths = 3;  // 30, 150, 270 deg (the rig's first azimuth: 30)
+  views.elevations_deg = {0, 25};
+  EXPECT_DOUBLE_EQ(views.azimuth_deg(4), 150.0);
+  EXPECT_DOUBLE_EQ(views.elevation_deg(4), 25.0);
+  EXPECT_DOUBLE_EQ(views.azimuth_deg(2), 270.0);
+  EXPECT_EQ(views.NearestView(30, 0), 0);
+  EXPECT_EQ(views.NearestView(150, 20), 4);
+  EXPECT_EQ(views.NearestView(280, 30), 5);
+  EXPECT_EQ(views.NearestView(-90, 5), 2);    // 270 deg
+  EXPECT_EQ(views.NearestView(100, 12), 4);   // nearer 150/25 than 30/0
+  EXPECT_EQ(views.NearestView(389, -10), 0);  // 29 deg
+}
+
+TEST(GenDataset, PlacementDriftAddsUpTheSteps) {
+  // Three frames of a 5-number row (one keypoint, root step, log-scale
+  // step): the first row's steps come from before the sequence and do not
+  // count; the scale doubles at frame 1, so frame 1's and frame 2's root
+  // steps count twice in first-frame units.
+  GenSequence sequence;
+  sequence.num_frames = 3;
+  sequence.features = {0, 0, 9.0f, 9.0f, 1.0f,  // ignored
+                       0, 0, 0.5f, 0.0f, static_cast<float>(std::log(2.0)),
+                       0, 0, 0.0f, 1.0f, 0.0f};
+  const PlacementDrift drift = PlacementDriftOf(sequence, 5);
+  EXPECT_NEAR(drift.log_scale_change, std::log(2.0), 1e-6);
+  EXPECT_NEAR(drift.root_displacement.x(), 1.0, 1e-6);
+  EXPECT_NEAR(drift.root_displacement.y(), 2.0, 1e-6);
+  // The data's cameras follow the walker: a walk looped to 20 s seen from
+  // a view ends near where it began.
+  GenViewOptions views;
+  views.num_azimuths = 2;
+  views.elevations_deg = {10};
+  const GenDataset dataset = BuildGenDataset({WalkSource()}, views, 30.0, 20.0);
+  for (const GenSequence& real : dataset.sequences) {
+    const PlacementDrift real_drift = PlacementDriftOf(real, 37);
+    EXPECT_LT(std::abs(real_drift.log_scale_change), 0.15) << real.name;
+    EXPECT_LT(real_drift.root_displacement.norm(), 0.5) << real.name;
+  }
 }
 
 TEST(GenDataset, RejectsViewsThatCannotBe) {
