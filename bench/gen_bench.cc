@@ -85,7 +85,7 @@ BENCHMARK(BM_DecodeWindow)->Unit(benchmark::kMicrosecond);
 // per code). Items = frames.
 void BM_MotionStream(benchmark::State& state) {
   torch::set_num_threads(1);
-  MotionStreamOptions options;
+  GenerationOptions options;
   options.decoding.emit_codes = static_cast<int>(state.range(0));
   MotionStream stream(UntrainedTokenizer(), UntrainedPrior(), options);
   std::vector<float> rows;

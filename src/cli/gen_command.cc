@@ -111,8 +111,7 @@ struct GenerateArgs {
   std::string run_dir;  // holds tokenizer.pt and prior.pt
   std::string output;
   double seconds = 10.0;
-  uint64_t seed = 1;
-  SamplingOptions sampling;
+  GenerationOptions generation;                  // --seed, sampling, placement
   std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
   double focal_px = 1000.0;
   // --policy: a tracker checkpoint driven along `generations` streams
@@ -202,9 +201,9 @@ int RunTrackedGenerations(const GenerateArgs& args) {
         character, config.env.simulation, first_camera, {root_px, scale_px});
     for (int g = 0; g < args.generations; ++g) {
       GeneratedStreamOptions stream_options;
-      stream_options.sampling = args.sampling;
-      stream_options.seed = args.seed + g;
-      stream_options.view =
+      stream_options.generation = args.generation;
+      stream_options.generation.seed = args.generation.seed + g;
+      stream_options.generation.view =
           GenerationView(generator_config, azimuth_deg, args.view[1]);
       stream_options.first_root_px = root_px;
       stream_options.first_scale_px = scale_px;
@@ -245,7 +244,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
           "  azimuth %.0f deg, generation %d (seed %llu): %s after %d of %d "
           "frames, E2D %.1f px, %.0fx real time\n",
           azimuth_deg, g + 1,
-          static_cast<unsigned long long>(stream_options.seed),
+          static_cast<unsigned long long>(stream_options.generation.seed),
           stats.failed ? "lost (early exit)" : "tracked to the end",
           stats.steps, env_options.max_episode_steps(), stats.mean_error_px(),
           stats.steps / config.env.simulation.control_hz /
@@ -281,7 +280,9 @@ int RunGenerate(const GenerateArgs& args) {
   // A prior conditioned on the view generates the data's view nearest to
   // --view.
   const GenConfig config = ReadPriorConfig(args.run_dir);
+  GenerationOptions generation = args.generation;
   const int view = GenerationView(config, args.view[0], args.view[1]);
+  generation.view = view;
   if (view >= 0) {
     std::printf(
         "generating the data's view %d (azimuth %.0f deg, elevation "
@@ -289,8 +290,8 @@ int RunGenerate(const GenerateArgs& args) {
         view, config.data.views.azimuth_deg(view),
         config.data.views.elevation_deg(view));
   }
-  const GeneratedMotion motion = GenerateMotion(args.run_dir, args.seconds,
-                                                args.sampling, args.seed, view);
+  const GeneratedMotion motion =
+      GenerateMotion(args.run_dir, args.seconds, generation);
   const int frames = motion.num_frames;
   const double fps = motion.fps;
 
@@ -338,9 +339,10 @@ int RunGenEval(const GenEvalArgs& args) {
         {"run_dir", args.run_dir},
         {"generations", args.options.generations},
         {"seconds", args.options.seconds},
-        {"temperature", args.options.sampling.temperature},
-        {"top_k", args.options.sampling.top_k},
-        {"kept_context_tokens", args.options.sampling.kept_context_tokens},
+        {"temperature", args.options.generation.sampling.temperature},
+        {"top_k", args.options.generation.sampling.top_k},
+        {"kept_context_tokens",
+         args.options.generation.sampling.kept_context_tokens},
         {"held_apart", args.held_apart},
         {"fid", result.fid},
         {"fid_floor_time", result.fid_floor_time},
@@ -351,9 +353,11 @@ int RunGenEval(const GenEvalArgs& args) {
         {"reconstruction_pose_error", result.reconstruction_pose_error},
         {"reconstruction_root_error", result.reconstruction_root_error},
         {"reconstruction_scale_error", result.reconstruction_scale_error},
-        {"decode_context_codes", args.options.decoding.context_codes},
-        {"lookahead_codes", args.options.decoding.lookahead_codes},
-        {"emit_codes", args.options.decoding.emit_codes},
+        {"decode_context_codes",
+         args.options.generation.decoding.context_codes},
+        {"lookahead_codes", args.options.generation.decoding.lookahead_codes},
+        {"emit_codes", args.options.generation.decoding.emit_codes},
+        {"placement_return_s", args.options.generation.placement_return_s},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},
         {"time_segments", args.options.time_segments},
@@ -373,7 +377,8 @@ int RunGenEval(const GenEvalArgs& args) {
 }
 
 // The sampling flags `gen eval` and `generate` share.
-void AddSamplingOptions(CLI::App* command, SamplingOptions* sampling) {
+void AddGenerationOptions(CLI::App* command, GenerationOptions* generation) {
+  SamplingOptions* sampling = &generation->sampling;
   command->add_option("--temperature", sampling->temperature,
                       "Sampling temperature (> 0; lower is greedier)");
   command->add_option("--top-k", sampling->top_k,
@@ -382,6 +387,11 @@ void AddSamplingOptions(CLI::App* command, SamplingOptions* sampling) {
       "--kept-context", sampling->kept_context_tokens,
       "Codes of the past the prior keeps in view when its full context "
       "slides (0: half the context)");
+  command->add_option(
+      "--placement-return", generation->placement_return_s,
+      "Time constant (s) with which the stream's scale and root return "
+      "toward their start, as the data's following cameras hold them (0: "
+      "off)");
 }
 
 }  // namespace
@@ -427,17 +437,19 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Independent generations (seeds 1..N)");
   eval->add_option("--seconds", eval_args->options.seconds,
                    "Length of each generation (s)");
-  AddSamplingOptions(eval, &eval_args->options.sampling);
+  AddGenerationOptions(eval, &eval_args->options.generation);
   eval->add_option("--held-apart", eval_args->held_apart,
                    "Motions the feature encoder is trained on (never the "
                    "generator's)")
       ->delimiter(',');
   eval->add_option("--decode-context",
-                   eval_args->options.decoding.context_codes,
+                   eval_args->options.generation.decoding.context_codes,
                    "Codes the streaming decoder sees per step");
-  eval->add_option("--lookahead", eval_args->options.decoding.lookahead_codes,
+  eval->add_option("--lookahead",
+                   eval_args->options.generation.decoding.lookahead_codes,
                    "Codes decoded after the ones emitted (latency)");
-  eval->add_option("--emit-codes", eval_args->options.decoding.emit_codes,
+  eval->add_option("--emit-codes",
+                   eval_args->options.generation.decoding.emit_codes,
                    "Codes whose frames one decoding emits");
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
@@ -462,8 +474,9 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->required();
   generate->add_option("--seconds", generate_args->seconds,
                        "Length of the generated motion (s)");
-  generate->add_option("--seed", generate_args->seed, "Sampling seed");
-  AddSamplingOptions(generate, &generate_args->sampling);
+  generate->add_option("--seed", generate_args->generation.seed,
+                       "Sampling seed");
+  AddGenerationOptions(generate, &generate_args->generation);
   generate
       ->add_option("--view", generate_args->view,
                    "Camera azimuth (deg), elevation (deg), distance (m)")

@@ -160,6 +160,19 @@ struct StreamDecoding {
   int emit_codes = 4;
 };
 
+// One generation: how its codes are drawn and decoded, its seed and view,
+// and how its placement is held.
+struct GenerationOptions {
+  SamplingOptions sampling;
+  StreamDecoding decoding;
+  uint64_t seed = 1;
+  int view = -1;  // the data's view to generate (a conditioned prior's)
+  // PlacementAnchor's return time (s): the stream's log scale and root are
+  // pulled back toward the first frame's, as the data's following cameras
+  // hold them (0: off; the steps as the prior draws them).
+  double placement_return_s = 0.0;
+};
+
 // Where and how a run goes.
 struct GenRunOptions {
   std::string run_dir = "runs/gen";  // tokenizer.pt, prior.pt, logs

@@ -14,7 +14,7 @@ namespace m2d {
 GeneratedStream::GeneratedStream(const std::string& run_dir,
                                  const GeneratedStreamOptions& options)
     : root_px_(options.first_root_px), scale_px_(options.first_scale_px) {
-  options.sampling.Validate();
+  options.generation.sampling.Validate();
   if (!(options.first_scale_px > 0)) {
     throw ConfigError("generated stream: the first scale must be positive");
   }
@@ -26,8 +26,7 @@ GeneratedStream::GeneratedStream(const std::string& run_dir,
   format_.image_height_px = options.image_height_px;
   stream_ = std::make_unique<MotionStream>(
       std::move(tokenizer), LoadPrior((run / kPriorFile).string()),
-      MotionStreamOptions{options.sampling, options.decoding, options.seed,
-                          options.view});
+      options.generation);
 }
 
 GeneratedStream::~GeneratedStream() = default;

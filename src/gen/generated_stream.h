@@ -19,10 +19,7 @@ namespace m2d {
 class MotionStream;
 
 struct GeneratedStreamOptions {
-  SamplingOptions sampling;
-  StreamDecoding decoding;
-  uint64_t seed = 1;
-  int view = -1;  // the data's view to generate (a conditioned prior's)
+  GenerationOptions generation;
   // The first frame's root and scale (px), as CanonicalFromFeatures takes
   // them: the first frame's own steps apply on top.
   Eigen::Vector2d first_root_px = Eigen::Vector2d(960, 540);

@@ -31,7 +31,7 @@ namespace {
 // `seconds` of motion streamed from loaded models.
 GeneratedMotion Generate(const LoadedTokenizer& tokenizer,
                          const LoadedPrior& prior, double seconds,
-                         const MotionStreamOptions& options) {
+                         const GenerationOptions& options) {
   GeneratedMotion motion;
   motion.fps = tokenizer.config.data.fps;
   MotionStream stream(tokenizer, prior, options);
@@ -57,13 +57,11 @@ void CheckGeneration(double seconds, const SamplingOptions& sampling) {
 }  // namespace
 
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
-                               const SamplingOptions& sampling, uint64_t seed,
-                               int view, const StreamDecoding& decoding) {
-  CheckGeneration(seconds, sampling);
+                               const GenerationOptions& generation) {
+  CheckGeneration(seconds, generation.sampling);
   const std::filesystem::path run(run_dir);
   return Generate(LoadTokenizer((run / kTokenizerFile).string()),
-                  LoadPrior((run / kPriorFile).string()), seconds,
-                  {sampling, decoding, seed, view});
+                  LoadPrior((run / kPriorFile).string()), seconds, generation);
 }
 
 int GenerationView(const GenConfig& config, double azimuth_deg,
@@ -212,14 +210,15 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   torch::set_num_threads(1);
   std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
-  CheckGeneration(options.seconds, options.sampling);
+  CheckGeneration(options.seconds, options.generation.sampling);
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   for (int g = 0; g < options.generations; ++g) {
     const int views = prior.config.prior_views();
+    GenerationOptions generation = options.generation;
+    generation.seed = static_cast<uint64_t>(g + 1);
+    generation.view = views > 0 ? g % views : -1;
     GeneratedMotion motion =
-        Generate(tokenizer, prior, options.seconds,
-                 {options.sampling, options.decoding,
-                  static_cast<uint64_t>(g + 1), views > 0 ? g % views : -1});
+        Generate(tokenizer, prior, options.seconds, generation);
     generation_s += motion.generation_s;
     generated_s += motion.num_frames / motion.fps;
     generated.push_back({"generated/" + std::to_string(g + 1),

@@ -31,13 +31,11 @@ struct GeneratedMotion {
 };
 
 // `seconds` of motion streamed from the run's prior and tokenizer
-// (gen/motion_stream.h), with `sampling` and `seed`; `view`: which of the
-// data's views a prior conditioned on the view generates (-1 for one that
-// is not; GenerationView picks it).
+// (gen/motion_stream.h). `generation.view`: which of the data's views a
+// prior conditioned on the view generates (-1 for one that is not;
+// GenerationView picks it).
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
-                               const SamplingOptions& sampling, uint64_t seed,
-                               int view = -1,
-                               const StreamDecoding& decoding = {});
+                               const GenerationOptions& generation);
 
 // The data view a run's prior generates for a camera at `azimuth_deg`,
 // `elevation_deg`: the nearest of its views when it is conditioned on the
@@ -50,10 +48,9 @@ struct GeneratorEvalOptions {
   // generates generation g in view g mod V, as evenly as the data holds
   // its views.
   int generations = 10;
-  double seconds = 60.0;  // per generation
-  SamplingOptions sampling;
-  StreamDecoding decoding;
-  int window_frames = 64;  // feature windows
+  double seconds = 60.0;         // per generation
+  GenerationOptions generation;  // its seed and view are set per generation
+  int window_frames = 64;        // feature windows
   int stride_frames = 16;
   int64_t encoder_steps = 3000;
   uint64_t seed = 1;  // encoder initialization and batches

@@ -194,6 +194,30 @@ PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size) {
   return drift;
 }
 
+PlacementAnchor::PlacementAnchor(double return_time_s, double fps) {
+  if (!(return_time_s >= 0.0 && std::isfinite(return_time_s)) || !(fps > 0))
+    throw ConfigError("placement return time must be >= 0 s (0: off)");
+  return_per_frame_ = return_time_s > 0 ? 1.0 / (return_time_s * fps) : 0.0;
+}
+
+void PlacementAnchor::Apply(float* rows, int num_frames, int frame_size) {
+  if (return_per_frame_ == 0.0) return;
+  const int root = frame_size - 3, log_scale = frame_size - 1;
+  for (int t = 0; t < num_frames; ++t) {
+    float* row = rows + static_cast<size_t>(t) * frame_size;
+    // Outline: the scale step gives back its share of the log scale; the
+    // root step (in this frame's scale) its share of the displacement.
+    row[log_scale] -= static_cast<float>(return_per_frame_ * log_scale_);
+    log_scale_ += row[log_scale];
+    const double scale = std::exp(log_scale_);
+    row[root] -=
+        static_cast<float>(return_per_frame_ * displacement_.x() / scale);
+    row[root + 1] -=
+        static_cast<float>(return_per_frame_ * displacement_.y() / scale);
+    displacement_ += scale * Eigen::Vector2d(row[root], row[root + 1]);
+  }
+}
+
 std::vector<GenSequence> DrawRealStretches(
     const std::vector<GenSequence>& sequences, int frame_size,
     int stretch_frames, int num_stretches, int min_frames, uint64_t seed) {

@@ -140,6 +140,27 @@ struct PlacementDrift {
 };
 PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size);
 
+// Holds a stream's placement near its start, as the data's following
+// cameras do: each frame's log-scale and root steps give back
+// 1 / (return_time_s * fps) of the log scale and root displacement
+// accumulated before it (PlacementDriftOf's quantities, counted from the
+// stream's first row). A prior over steps sees 4 s of context and cannot
+// keep what the steps add up to over minutes near 0; this restores the
+// mean reversion a following camera gives real motion. Rows are changed
+// in place, in stream order, across calls.
+class PlacementAnchor {
+ public:
+  // return_time_s: time constant of the return (s); 0 leaves rows as they
+  // are. ConfigError when negative or not finite.
+  PlacementAnchor(double return_time_s, double fps);
+  void Apply(float* rows, int num_frames, int frame_size);
+
+ private:
+  double return_per_frame_ = 0.0;
+  double log_scale_ = 0.0;                                  // log(s / s_0)
+  Eigen::Vector2d displacement_ = Eigen::Vector2d::Zero();  // s_0 units
+};
+
 // Per-channel mean and std (floored) of every row of `sequences`.
 void FeatureStatistics(const std::vector<GenSequence>& sequences,
                        int frame_size, std::vector<float>* mean,

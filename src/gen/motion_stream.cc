@@ -7,10 +7,11 @@
 namespace m2d {
 
 MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
-                           const MotionStreamOptions& options)
+                           const GenerationOptions& options)
     : tokenizer_(std::move(tokenizer)),
       sampler_(prior.model, options.sampling, options.seed, options.view),
-      options_(options) {
+      options_(options),
+      anchor_(options.placement_return_s, tokenizer_.config.data.fps) {
   if (prior.model->num_codes() != tokenizer_.model->num_codes()) {
     throw ConfigError("the prior predicts " +
                       std::to_string(prior.model->num_codes()) +
@@ -56,6 +57,8 @@ void MotionStream::Next(std::vector<float>* rows) {
                              .contiguous();
     decoded_.assign(kept.data_ptr<float>(),
                     kept.data_ptr<float>() + kept.numel());
+    anchor_.Apply(decoded_.data(), static_cast<int>(decoded_.size() / row_size),
+                  static_cast<int>(row_size));
     next_decoded_row_ = 0;
   }
   const auto first = decoded_.begin() + next_decoded_row_ * row_size;

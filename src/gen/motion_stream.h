@@ -12,21 +12,16 @@
 
 namespace m2d {
 
-struct MotionStreamOptions {
-  SamplingOptions sampling;
-  StreamDecoding decoding;
-  uint64_t seed = 1;
-  int view = -1;  // the data's view to generate (a conditioned prior's)
-};
-
 // Each Next() emits one code's frames. Frames are decoded for
 // `decoding.emit_codes` codes at a time, once `decoding.lookahead_codes`
 // codes after them exist, so that the decoder does not work at the
-// window's open edge; later calls emit the frames already decoded.
+// window's open edge; later calls emit the frames already decoded. The
+// decoded frames' placement steps are held by a PlacementAnchor
+// (options.placement_return_s; off by default).
 class MotionStream {
  public:
   MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
-               const MotionStreamOptions& options);
+               const GenerationOptions& options);
 
   // Appends frames_per_token() rows of X^can (not normalized; rows of
   // CanonicalFeatures) to `rows`.
@@ -39,7 +34,8 @@ class MotionStream {
  private:
   LoadedTokenizer tokenizer_;
   TokenSampler sampler_;
-  MotionStreamOptions options_;
+  GenerationOptions options_;
+  PlacementAnchor anchor_;  // holds the emitted rows' placement
   int64_t emitted_codes_ = 0;
   std::vector<float> decoded_;   // frames decoded, not yet emitted
   size_t next_decoded_row_ = 0;  // in decoded_, in rows

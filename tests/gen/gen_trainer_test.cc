@@ -107,7 +107,7 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
   const GenDataset dataset = WalkDataset();
   const GenConfig config = TinyConfig(TempRun("stream"));
   TrainGenerator(config, dataset, false, nullptr, nullptr);
-  MotionStreamOptions options;
+  GenerationOptions options;
   options.seed = 3;
   MotionStream stream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
                       LoadPrior(config.run.run_dir + "/prior.pt"), options);
@@ -130,7 +130,26 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
   EXPECT_EQ(per_code_rows.size(), rows.size());
   for (size_t i = 0; i < per_code.codes().size(); ++i)
     EXPECT_EQ(per_code.codes()[i], stream.codes()[i]);
+  // An anchored placement changes the root and scale steps only, and
+  // holds them nearer the start.
+  options.decoding.emit_codes = 4;
+  options.placement_return_s = 0.5;
+  MotionStream anchored(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                        LoadPrior(config.run.run_dir + "/prior.pt"), options);
+  std::vector<float> anchored_rows;
+  for (int i = 0; i < 20; ++i) anchored.Next(&anchored_rows);
+  ASSERT_EQ(anchored_rows.size(), rows.size());
+  int changed = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (i % 37 < 34) {
+      ASSERT_EQ(anchored_rows[i], rows[i]) << "local pose, row " << i / 37;
+    } else {
+      changed += anchored_rows[i] != rows[i];
+    }
+  }
+  EXPECT_GT(changed, 0);
   // Settings it cannot keep.
+  options.placement_return_s = 0.0;
   options.decoding.emit_codes = 16;
   EXPECT_THROW(
       MotionStream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
@@ -145,16 +164,18 @@ TEST(GenTrainer, TheGeneratedStreamIsTheGeneratedClip) {
   const GenConfig config = TinyConfig(TempRun("generated_stream"));
   TrainGenerator(config, WalkDataset(), false, nullptr, nullptr);
   const SamplingOptions sampling{0.9, 0};
+  GenerationOptions generation;
+  generation.sampling = sampling;
+  generation.seed = 7;
   const GeneratedMotion motion =
-      GenerateMotion(config.run.run_dir, 3.0, sampling, 7);
+      GenerateMotion(config.run.run_dir, 3.0, generation);
   const Eigen::Vector2d root_px(900, 600);
   const double scale_px = 80.0;
   const Clip2D clip = FromCanonical(
       CanonicalFromFeatures(motion.rows.data(), motion.num_frames,
                             Coco17Layout(), motion.fps, root_px, scale_px));
   GeneratedStreamOptions options;
-  options.sampling = sampling;
-  options.seed = 7;
+  options.generation = generation;
   options.first_root_px = root_px;
   options.first_scale_px = scale_px;
   GeneratedStream stream(config.run.run_dir, options);
@@ -172,7 +193,7 @@ TEST(GenTrainer, TheGeneratedStreamIsTheGeneratedClip) {
     }
   }
   EXPECT_LT(worst_px, 1e-6);
-  options.sampling.temperature = 0.0;
+  options.generation.sampling.temperature = 0.0;
   EXPECT_THROW(GeneratedStream(config.run.run_dir, options), ConfigError);
 }
 
@@ -234,13 +255,16 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_THROW(EvaluateGenerator(config.run.run_dir, walk, walk, options),
                ConfigError);
   // What a user gets from `generate`: the frames asked for, finite.
+  GenerationOptions generation;
+  generation.sampling = SamplingOptions{0.8, 5};
+  generation.seed = 4;
   const GeneratedMotion motion =
-      GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.8, 5}, 4);
+      GenerateMotion(config.run.run_dir, 2.0, generation);
   EXPECT_EQ(motion.num_frames, 60);
   EXPECT_EQ(motion.rows.size(), 60u * 37);
-  EXPECT_THROW(
-      GenerateMotion(config.run.run_dir, 2.0, SamplingOptions{0.0, 0}, 4),
-      ConfigError);
+  generation.sampling.temperature = 0.0;
+  EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, generation),
+               ConfigError);
 }
 
 TEST(GenTrainer, AViewConditionedPriorGeneratesTheViewAskedFor) {
@@ -261,17 +285,20 @@ TEST(GenTrainer, AViewConditionedPriorGeneratesTheViewAskedFor) {
   EXPECT_EQ(GenerationView(config, 200, 0), 1);
   EXPECT_EQ(GenerationView(config, 30, 40), 0);
   EXPECT_EQ(GenerationView(TinyConfig("unconditioned"), 200, 0), -1);
-  const SamplingOptions sampling{1.0, 0};
+  GenerationOptions generation;
+  generation.seed = 3;
+  generation.view = 1;
   const GeneratedMotion motion =
-      GenerateMotion(config.run.run_dir, 2.0, sampling, 3, /*view=*/1);
+      GenerateMotion(config.run.run_dir, 2.0, generation);
   EXPECT_EQ(motion.num_frames, 60);
   for (float value : motion.rows) ASSERT_TRUE(std::isfinite(value));
-  EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, sampling, 3),
-               ConfigError);
-  EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, sampling, 3, 2),
-               ConfigError);
+  for (int view : {-1, 2}) {
+    generation.view = view;
+    EXPECT_THROW(GenerateMotion(config.run.run_dir, 2.0, generation),
+                 ConfigError);
+  }
   GeneratedStreamOptions stream_options;
-  stream_options.view = 0;
+  stream_options.generation.view = 0;
   GeneratedStream stream(config.run.run_dir, stream_options);
   std::vector<Keypoint2D> frame;
   for (int t = 0; t < 40; ++t) ASSERT_TRUE(stream.Next(&frame));

@@ -136,6 +136,34 @@ TEST(GenDataset, PlacementDriftAddsUpTheSteps) {
   }
 }
 
+TEST(GenDataset, AnAnchoredPlacementReturnsToItsStart) {
+  // A stream whose steps all push one way (log scale +0.001, root +0.01
+  // body scales per frame): unanchored it drifts without bound; anchored
+  // with a 2-s return at 30 Hz it settles where the push and the return
+  // balance (step = return_per_frame * accumulated: 0.001 * 60 = 0.06).
+  const int frames = 1800, size = 5;
+  std::vector<float> rows;
+  for (int t = 0; t < frames; ++t)
+    rows.insert(rows.end(), {0.f, 0.f, 0.01f, 0.f, 0.001f});
+  GenSequence free{"free", frames, rows}, anchored{"anchored", frames, rows};
+  PlacementAnchor anchor(2.0, 30.0);
+  // In two calls: the anchor carries its state across them.
+  anchor.Apply(anchored.features.data(), 700, size);
+  anchor.Apply(anchored.features.data() + 700 * size, frames - 700, size);
+  EXPECT_NEAR(PlacementDriftOf(free, size).log_scale_change, 1.799, 1e-3);
+  const PlacementDrift drift = PlacementDriftOf(anchored, size);
+  EXPECT_NEAR(drift.log_scale_change, 0.06, 0.003);
+  // The root: 0.01 body scales of this frame's scale (e^0.06 of the first)
+  // against 1/60 of the displacement.
+  EXPECT_NEAR(drift.root_displacement.x(), 0.01 * std::exp(0.06) * 60, 0.02);
+  EXPECT_NEAR(drift.root_displacement.y(), 0.0, 1e-6);
+  // Off: rows as they are.
+  GenSequence untouched = free;
+  PlacementAnchor(0.0, 30.0).Apply(untouched.features.data(), frames, size);
+  EXPECT_EQ(untouched.features, free.features);
+  EXPECT_THROW(PlacementAnchor(-1.0, 30.0), ConfigError);
+}
+
 TEST(GenDataset, RejectsViewsThatCannotBe) {
   GenViewOptions views;
   views.elevations_deg = {};
