@@ -10,7 +10,8 @@
 #
 # Needs scripts/make_dataset.sh's bundles and the checkpoints of
 # configs/dataset2d.yaml, dataset3d_gt.yaml and dataset_sfv.yaml (a missing
-# checkpoint's rows are skipped and say so). Every rollout starts at a
+# checkpoint's rows are skipped and say so; OURS_CHECKPOINT, GT_CHECKPOINT
+# and SFV_CHECKPOINT name others). Every rollout starts at a
 # clip's first frame and runs to its end (clips are 0.8-4.4 s): one rollout
 # per view. Prints a Markdown table; every row's eval JSON goes to OUT_DIR.
 set -euo pipefail
@@ -25,9 +26,10 @@ train_clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin
 # out the crawl and the get-up: their fits do not converge).
 unseen_clips="dance_spin roll"
 
-ours=runs/dataset2d/checkpoint.pt
-gt=runs/dataset3d_gt/checkpoint.pt
-sfv=runs/dataset_sfv/checkpoint.pt
+# The checkpoints (each overridable, e.g. to table a variant's run).
+ours=${OURS_CHECKPOINT:-runs/dataset2d/checkpoint.pt}
+gt=${GT_CHECKPOINT:-runs/dataset3d_gt/checkpoint.pt}
+sfv=${SFV_CHECKPOINT:-runs/dataset_sfv/checkpoint.pt}
 
 # bundles SPLIT SUFFIX: --bundle flags for the split's clips.
 bundles() {

@@ -390,8 +390,8 @@ void AddGenerationOptions(CLI::App* command, GenerationOptions* generation) {
   command->add_option(
       "--placement-return", generation->placement_return_s,
       "Time constant (s) with which the stream's scale and root return "
-      "toward their start, as the data's following cameras hold them (0: "
-      "off)");
+      "toward their start, as the data's following cameras hold them "
+      "(default 20; 0: off)");
 }
 
 }  // namespace

@@ -17,7 +17,7 @@ namespace m2d {
 // codes after them exist, so that the decoder does not work at the
 // window's open edge; later calls emit the frames already decoded. The
 // decoded frames' placement steps are held by a PlacementAnchor
-// (options.placement_return_s; off by default).
+// (options.placement_return_s).
 class MotionStream {
  public:
   MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
