@@ -43,6 +43,18 @@ GenConfig TinyConfig(const std::string& run_dir) {
   return config;
 }
 
+// The FID protocol at a tiny size: 16-frame windows, a few encoder steps.
+GeneratorEvalOptions TinyEvalOptions(double seconds, int time_segments) {
+  GeneratorEvalOptions options;
+  options.generations = 2;
+  options.seconds = seconds;
+  options.window_frames = 16;
+  options.stride_frames = 8;
+  options.encoder_steps = 20;
+  options.time_segments = time_segments;
+  return options;
+}
+
 std::string TempRun(const std::string& name) {
   const std::string dir =
       (std::filesystem::temp_directory_path() / ("m2d_gen_" + name)).string();
@@ -203,13 +215,8 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   const GenDataset walk = WalkDataset();
   const GenConfig config = TinyConfig(TempRun("measured"));
   TrainGenerator(config, walk, false, nullptr, nullptr);
-  GeneratorEvalOptions options;
-  options.generations = 2;
-  options.seconds = 3.0;
-  options.window_frames = 16;
-  options.stride_frames = 8;
-  options.encoder_steps = 20;
-  options.time_segments = 2;  // 45 frames each: 4 windows per generation
+  // Segments of 45 frames: 4 windows per generation.
+  GeneratorEvalOptions options = TinyEvalOptions(3.0, 2);
   const GeneratorEvalResult result =
       EvaluateGenerator(config.run.run_dir, walk, walk, options);
   EXPECT_EQ(result.generated_windows, 2 * ((90 - 16) / 8 + 1));
@@ -303,16 +310,10 @@ TEST(GenTrainer, AViewConditionedPriorGeneratesTheViewAskedFor) {
   std::vector<Keypoint2D> frame;
   for (int t = 0; t < 40; ++t) ASSERT_TRUE(stream.Next(&frame));
   // The evaluation generates every view in turn.
-  GeneratorEvalOptions options;
-  options.generations = 2;
-  options.seconds = 2.0;
-  options.window_frames = 16;
-  options.stride_frames = 8;
-  options.encoder_steps = 10;
-  options.time_segments = 1;
-  EXPECT_TRUE(std::isfinite(EvaluateGenerator(config.run.run_dir, WalkDataset(),
-                                              WalkDataset(), options)
-                                .fid));
+  EXPECT_TRUE(
+      std::isfinite(EvaluateGenerator(config.run.run_dir, WalkDataset(),
+                                      WalkDataset(), TinyEvalOptions(2.0, 1))
+                        .fid));
 }
 
 TEST(GenTrainer, ADamagedCheckpointIsNamed) {
