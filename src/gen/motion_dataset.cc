@@ -196,7 +196,8 @@ PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size) {
 
 PlacementAnchor::PlacementAnchor(double return_time_s, double fps) {
   if (!(return_time_s >= 0.0 && std::isfinite(return_time_s)) || !(fps > 0))
-    throw ConfigError("placement return time must be >= 0 s (0: off)");
+    throw ConfigError(
+        "placement return time (--placement-return) must be >= 0 s (0: off)");
   return_per_frame_ = return_time_s > 0 ? 1.0 / (return_time_s * fps) : 0.0;
 }
 
