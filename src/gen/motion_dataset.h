@@ -51,9 +51,9 @@ struct GenViewOptions {
   int num_views() const {
     return num_azimuths * static_cast<int>(elevations_deg.size());
   }
-  // The data's views in order (view v: elevation v / num_azimuths, azimuth
-  // v % num_azimuths): azimuth of view k of an elevation (deg; the rig's,
-  // camera/rig.h, from its first azimuth).
+  // View v of the data is seen from elevation v / num_azimuths and azimuth
+  // v % num_azimuths (the rig's azimuths, camera/rig.h, from its first):
+  // its angles in degrees.
   double azimuth_deg(int view) const;
   double elevation_deg(int view) const;
   // The view nearest to a camera at `azimuth_deg`, `elevation_deg`
