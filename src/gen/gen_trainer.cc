@@ -114,7 +114,7 @@ torch::Tensor SampleWindows(const GenDataset& dataset, int window, int batch,
       const float* row = sequence.features.data() + frame * frame_size;
       std::copy(row, row + frame_size, out + t * frame_size);
       if (start + t >= sequence.num_frames) {  // held: no root or scale step
-        std::fill(out + t * frame_size + frame_size - 3,
+        std::fill(out + t * frame_size + RootStepColumn(frame_size),
                   out + (t + 1) * frame_size, 0.0f);
       }
     }

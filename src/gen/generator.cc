@@ -169,7 +169,7 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     const torch::Tensor decoded =
         tokenizer.model->Decode(tokenizer.model->Encode(real_windows));
     const torch::Tensor error = (decoded - real_windows).abs() * tokenizer.std;
-    const int pose = frame_size - 3;
+    const int pose = RootStepColumn(frame_size);  // the local pose before it
     result.reconstruction_pose_error =
         error.narrow(2, 0, pose).mean().item<double>();
     result.reconstruction_root_error =
@@ -212,8 +212,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   double generation_s = 0.0, generated_s = 0.0;
   CheckGeneration(options.seconds, options.generation.sampling);
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
+  const int views = prior.config.prior_views();
   for (int g = 0; g < options.generations; ++g) {
-    const int views = prior.config.prior_views();
     GenerationOptions generation = options.generation;
     generation.seed = static_cast<uint64_t>(g + 1);
     generation.view = views > 0 ? g % views : -1;

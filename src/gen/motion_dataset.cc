@@ -180,9 +180,8 @@ std::pair<GenSequence, GenSequence> SplitSequenceInTime(
 }
 
 PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size) {
-  // Row layout (CanonicalFeatures): local pose, then the root step (2),
-  // then the log-scale step (1).
-  const int root = frame_size - 3, log_scale = frame_size - 1;
+  const int root = RootStepColumn(frame_size);
+  const int log_scale = LogScaleStepColumn(frame_size);
   PlacementDrift drift;
   for (int t = 1; t < sequence.num_frames; ++t) {
     const float* row =
@@ -203,7 +202,8 @@ PlacementAnchor::PlacementAnchor(double return_time_s, double fps) {
 
 void PlacementAnchor::Apply(float* rows, int num_frames, int frame_size) {
   if (return_per_frame_ == 0.0) return;
-  const int root = frame_size - 3, log_scale = frame_size - 1;
+  const int root = RootStepColumn(frame_size);
+  const int log_scale = LogScaleStepColumn(frame_size);
   for (int t = 0; t < num_frames; ++t) {
     float* row = rows + static_cast<size_t>(t) * frame_size;
     // Outline: the scale step gives back its share of the log scale; the

@@ -20,6 +20,9 @@ namespace m2d {
 // One frame of X^can as numbers: x̄ (J × 2, x then y per keypoint), then
 // delta_root (2), then delta_log_scale (1).
 int CanonicalFrameSize(const KeypointLayout& layout);
+// Where a row's root step (2 numbers) and log-scale step (1) sit.
+inline int RootStepColumn(int frame_size) { return frame_size - 3; }
+inline int LogScaleStepColumn(int frame_size) { return frame_size - 1; }
 
 // Frame-major rows of X^can. A missing keypoint (its local coordinates are
 // NaN) repeats its last present value in the clip (its first present value
