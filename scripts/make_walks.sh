@@ -6,7 +6,8 @@
 # policy's bundle), stripped to their 2D and fitted view by view with the
 # focal known: a user's four following videos per walk.
 #
-#   scripts/make_walks.sh [OUT_DIR] [WALK...]   (default runs/walks, all nine)
+#   [FIT_THREADS=N] scripts/make_walks.sh [OUT_DIR] [WALK...]   (default runs/walks,
+#   all nine; the fit's threads, default 2)
 #
 # Writes OUT_DIR/<walk>_truth.json (the measurement's side), <walk>_2d.json
 # (stripped) and <walk>.json (the fit's estimate: what training reads).
@@ -35,7 +36,7 @@ for walk in "${walks[@]}"; do
   $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
     > /dev/null
   if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \
-    --threads 2 --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
+    --threads "${FIT_THREADS:-2}" --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
   then
     echo "fitted $walk: $(grep -c 'all frames converged' "$out/${walk}_fit.log") of 4 views converged on every frame"
   else

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +17,7 @@
 #include "common/file_io.h"
 #include "env/reference.h"
 #include "env/reference_stream.h"
+#include "fit/fit.h"
 #include "gen/gen_config.h"
 #include "gen/gen_trainer.h"
 #include "gen/generated_stream.h"
@@ -107,6 +109,17 @@ int RunGenTrain(const GenTrainArgs& args) {
   return summary.interrupted ? 130 : 0;
 }
 
+// Where a tracked generation starts. The generated 2D has no 3D and no
+// camera: like a user's video, it is fitted.
+enum class GeneratedStart {
+  // The fit (fit/fit.h) of the stream's first seconds as a user's clip
+  // (a moving camera, the focal --focal): its first pose and camera.
+  kFit,
+  // The default pose placed under the first frame, facing the --view
+  // camera (before 2026-11-26 the only start).
+  kDefault,
+};
+
 struct GenerateArgs {
   std::string run_dir;  // holds tokenizer.pt and prior.pt
   std::string output;
@@ -120,6 +133,9 @@ struct GenerateArgs {
   int generations = 1;
   std::vector<double> azimuths_deg;  // with --policy: views (default --view's)
   std::string video;
+  // With --policy: where each rollout starts and which camera it is seen by.
+  GeneratedStart start = GeneratedStart::kFit;
+  double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
 };
 
 // The camera at `azimuth_deg` and --view's elevation and distance: the
@@ -165,12 +181,29 @@ void StandingPlacement(const PinholeCamera& camera, Eigen::Vector2d* root_px,
   }
 }
 
+// The first `seconds` of the stream `options` describe, as a clip: the
+// frames the tracker will be handed, drawn by a stream of their own.
+Clip2D FirstFramesOf(const std::string& run_dir,
+                     const GeneratedStreamOptions& options, double seconds) {
+  GeneratedStream stream(run_dir, options);
+  Clip2D clip = stream.format();
+  const int frames = std::max(1, static_cast<int>(seconds * clip.fps + 0.5));
+  const int num_keypoints = clip.layout->num_keypoints();
+  clip.keypoints = KeypointTrack(frames, num_keypoints);
+  std::vector<Keypoint2D> frame;
+  for (int t = 0; t < frames && stream.Next(&frame); ++t) {
+    for (int j = 0; j < num_keypoints; ++j) clip.keypoints.at(t, j) = frame[j];
+  }
+  return clip;
+}
+
 // The checkpoint's tracker along `args.generations` generated streams seen
-// from --view: each starts from the default pose placed under the
-// placement, and the camera dollies with the simulated character (the
-// generator learned from cameras that followed the subject). A rollout
-// succeeds when it tracks --seconds without an early exit. Prints a line
-// per generation and the totals; draws the first with --video.
+// from --view. Each starts where args.start says (by default the fit of the
+// stream's first seconds: its first pose, seen by its first camera); the
+// camera then dollies with the simulated character (the generator learned
+// from cameras that followed the subject). A rollout succeeds when it
+// tracks --seconds without an early exit. Prints a line per generation and
+// the totals; draws the first with --video.
 int RunTrackedGenerations(const GenerateArgs& args) {
   TorchPolicy policy(args.policy);
   const TrainConfig& config = policy.config();
@@ -183,22 +216,34 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   const std::vector<double> azimuths_deg =
       args.azimuths_deg.empty() ? std::vector<double>{args.view[0]}
                                 : args.azimuths_deg;
+  FitOptions fit_options;  // the stream's first seconds as a user's clip
+  fit_options.camera_motion = CameraMotion::kMoving;
+  fit_options.fixed_focal_px = args.focal_px;
+  fit_options.num_threads = 1;
+  fit_options.Validate();
   std::printf(
       "tracking with %s: %d generation(s) x %.0f s x %zu view(s) (elevation "
-      "%.0f deg, %.1f m)\nstarts from the default pose placed under the "
-      "first generated frame (no 3D), cameras the chosen view dollying with "
-      "the character\n",
+      "%.0f deg, %.1f m)\n",
       args.policy.c_str(), args.generations, args.seconds, azimuths_deg.size(),
       args.view[1], args.view[2]);
-  int succeeded = 0, rollouts = 0;
+  if (args.start == GeneratedStart::kFit) {
+    std::printf(
+        "starts and cameras from the fit of each stream's first %.1f s "
+        "(moving camera, focal %.0f px; no 3D), the camera dollying with the "
+        "character\n",
+        args.start_fit_s, args.focal_px);
+  } else {
+    std::printf(
+        "starts from the default pose placed under the first generated frame "
+        "(no 3D), cameras the chosen view dollying with the character\n");
+  }
+  int succeeded = 0, rollouts = 0, unfitted = 0;
   double e2d_sum_px = 0.0;
   for (double azimuth_deg : azimuths_deg) {
-    const PinholeCamera first_camera = ViewCamera(args, azimuth_deg);
+    const PinholeCamera view_camera = ViewCamera(args, azimuth_deg);
     Eigen::Vector2d root_px;
     double scale_px = 0.0;
-    StandingPlacement(first_camera, &root_px, &scale_px);
-    const SimState start = PlacedDefaultState(
-        character, config.env.simulation, first_camera, {root_px, scale_px});
+    StandingPlacement(view_camera, &root_px, &scale_px);
     for (int g = 0; g < args.generations; ++g) {
       GeneratedStreamOptions stream_options;
       stream_options.generation = args.generation;
@@ -207,8 +252,43 @@ int RunTrackedGenerations(const GenerateArgs& args) {
           GenerationView(generator_config, azimuth_deg, args.view[1]);
       stream_options.first_root_px = root_px;
       stream_options.first_scale_px = scale_px;
-      stream_options.image_width_px = first_camera.intrinsics().width_px;
-      stream_options.image_height_px = first_camera.intrinsics().height_px;
+      stream_options.image_width_px = view_camera.intrinsics().width_px;
+      stream_options.image_height_px = view_camera.intrinsics().height_px;
+
+      // The start and the first camera.
+      SimState start;
+      PinholeCamera first_camera = view_camera;
+      if (args.start == GeneratedStart::kFit) {
+        const Clip2D first_frames =
+            FirstFramesOf(args.run_dir, stream_options, args.start_fit_s);
+        const std::string source =
+            "generation " + std::to_string(g + 1) + " (azimuth " +
+            std::to_string(static_cast<int>(azimuth_deg)) + " deg)";
+        ViewEstimate estimate;
+        try {
+          estimate = FitView(first_frames, *character, fit_options, source);
+        } catch (const InputError& e) {
+          // Generated 2D a fit cannot use (a person leaving the image, too
+          // few frames): that generation is lost, the others still run.
+          std::printf(
+              "  fit of its first %d frames failed (%s): azimuth %.0f deg, "
+              "generation %d counted as lost\n",
+              first_frames.num_frames(), e.what(), azimuth_deg, g + 1);
+          ++unfitted;
+          continue;
+        }
+        start =
+            EstimatedState(character, config.env.simulation, estimate.poses, 0);
+        first_camera = estimate.CameraAt(0);
+        std::printf(
+            "  fit of its first %d frames: %.1f px, %s\n",
+            first_frames.num_frames(), estimate.summary.mean_reprojection_px,
+            estimate.summary.converged() ? "every frame converged"
+                                         : "some frames did not converge");
+      } else {
+        start = PlacedDefaultState(character, config.env.simulation,
+                                   view_camera, {root_px, scale_px});
+      }
       GeneratedStream stream(args.run_dir, stream_options);
       StreamedRollout rollout(
           character, env_options, &stream,
@@ -265,8 +345,14 @@ int RunTrackedGenerations(const GenerateArgs& args) {
                   summary.frames_rendered);
     }
   }
-  std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px\n", succeeded, rollouts,
-              100.0 * succeeded / rollouts, e2d_sum_px / rollouts);
+  // A generation whose start could not be fitted counts as lost; E2D is
+  // over the rollouts that ran.
+  const int total = rollouts + unfitted;
+  std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px", succeeded, total,
+              100.0 * succeeded / total,
+              rollouts > 0 ? e2d_sum_px / rollouts : 0.0);
+  if (unfitted > 0) std::printf(", %d not started (fit failed)", unfitted);
+  std::printf("\n");
   return 0;
 }
 
@@ -502,6 +588,20 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->delimiter(',');
   generate->add_option("--video", generate_args->video,
                        "With --policy: the first tracked stream drawn (MP4)");
+  generate
+      ->add_option("--start", generate_args->start,
+                   "With --policy: fit (the fit of each stream's first "
+                   "--start-fit-s seconds gives the first pose and camera) "
+                   "or default (the default pose under the --view camera)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, GeneratedStart>{
+              {"fit", GeneratedStart::kFit},
+              {"default", GeneratedStart::kDefault}},
+          CLI::ignore_case));
+  generate
+      ->add_option("--start-fit-s", generate_args->start_fit_s,
+                   "With --start fit: seconds of each stream fitted")
+      ->check(CLI::Range(0.5, 60.0));
   generate->callback([run, generate_args] {
     *run = [generate_args] { return RunGenerate(*generate_args); };
   });

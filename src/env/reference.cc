@@ -173,6 +173,16 @@ void QvelAtFrame(const Character& character, const std::vector<Pose3D>& poses,
   }
 }
 
+// Puts the character in fitted pose `t` of `poses`, moving at their central
+// differences, lifted out of the floor when the pose grazes it (never
+// lowered). `qvel` is scratch of the model's nv.
+void SetEstimatedPose(const std::vector<Pose3D>& poses, int t, double dt_s,
+                      std::vector<double>* qvel, Simulation& simulation) {
+  QvelAtFrame(simulation.character(), poses, t, dt_s, qvel);
+  simulation.SetPose(poses[t], qvel->data());
+  RaiseCharacter(std::max(0.0, -LowestCharacterPointZ(simulation)), simulation);
+}
+
 }  // namespace
 
 std::shared_ptr<const TrackingReference> TrackingReference::Prepare(
@@ -355,16 +365,10 @@ InitialStates::InitialStates(const TrackingReference& reference,
           simulation.SetPose(poses[t], qvel.data());
           break;
         }
-        case InitialStateSource::kEstimate: {
-          const std::vector<Pose3D>& poses =
-              (*bundle.estimate)[view.view].poses;
-          QvelAtFrame(*character, poses, t, dt_s, &qvel);
-          simulation.SetPose(poses[t], qvel.data());
-          // A fitted pose may graze the floor: lift it out, never down.
-          RaiseCharacter(std::max(0.0, -LowestCharacterPointZ(simulation)),
-                         simulation);
+        case InitialStateSource::kEstimate:
+          SetEstimatedPose((*bundle.estimate)[view.view].poses, t, dt_s, &qvel,
+                           simulation);
           break;
-        }
         case InitialStateSource::kDefault:
           // Placed from the bundle's first view.
           simulation.SetPose(PlaceDefaultPose(
@@ -383,6 +387,21 @@ InitialStates::InitialStates(const TrackingReference& reference,
     buffers_.push_back(std::move(buffer));
     motions_.push_back(std::move(motion));
   }
+}
+
+SimState EstimatedState(std::shared_ptr<const Character> character,
+                        const SimulationOptions& simulation_options,
+                        const std::vector<Pose3D>& poses, int frame) {
+  if (frame < 0 || frame >= static_cast<int>(poses.size())) {
+    throw ConfigError("EstimatedState: frame " + std::to_string(frame) +
+                      " of " + std::to_string(poses.size()) + " poses");
+  }
+  Simulation simulation(character, simulation_options);
+  simulation.Reset();
+  std::vector<double> qvel(character->model()->nv, 0.0);
+  SetEstimatedPose(poses, frame, 1.0 / simulation_options.control_hz, &qvel,
+                   simulation);
+  return simulation.Save();
 }
 
 SimState PlacedDefaultState(std::shared_ptr<const Character> character,

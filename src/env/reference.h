@@ -79,6 +79,15 @@ uint64_t ReferenceFingerprint(const TrackingReference& reference);
 void ReadBodyTarget(const Simulation& simulation, const double* keypoints_xyz,
                     BodyTarget3D* target);
 
+// The `estimate` initial state of `frame` of a view's fitted `poses`: that
+// pose, moving at the poses' central differences, lifted out of the floor
+// when it grazes it. What InitialStates fills from an estimate, and what a
+// generated stream's rollout starts from (its first seconds fitted).
+// ConfigError for a frame outside the poses.
+SimState EstimatedState(std::shared_ptr<const Character> character,
+                        const SimulationOptions& simulation_options,
+                        const std::vector<Pose3D>& poses, int frame);
+
 // The `default` initial state of a frame seen by `camera` whose image root
 // and scale are `image`: the model's default pose, turned to face the
 // camera and moved so that its root keypoints project onto the 2D root, at

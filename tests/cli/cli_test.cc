@@ -73,6 +73,15 @@ TEST(Cli, BvhDemoMotionBecomesABundle) {
   EXPECT_EQ(ReadBundle(dir + "/b.json").views.size(), 2u);
 }
 
+// How many times `needle` occurs in `text`.
+int CountOccurrences(const std::string& text, const std::string& needle) {
+  int count = 0;
+  for (size_t at = text.find(needle); at != std::string::npos;
+       at = text.find(needle, at + needle.size()))
+    ++count;
+  return count;
+}
+
 // `generate --policy`: a tracker driven along generated 2D streamed frame
 // by frame (a tiny generator trained here, the committed walk2d tracker), a
 // line per stream, the totals and the first stream drawn.
@@ -94,9 +103,10 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const std::string policy =
       testing::SourcePath("assets/policies/walk2d/checkpoint.pt");
-  result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
-                      policy + " --generations 2 --azimuths 30,120 --video " +
-                      dir + "/tracked.mp4 -o " + dir + "/generated.json");
+  result =
+      RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " + policy +
+                 " --generations 2 --azimuths 30,120 --start-fit-s 1 --video " +
+                 dir + "/tracked.mp4 -o " + dir + "/generated.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("azimuth 120 deg, generation 2 (seed 2): "),
             std::string::npos)
@@ -105,6 +115,22 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   EXPECT_NE(result.output.find("/4 ("), std::string::npos) << result.output;
   EXPECT_GT(std::filesystem::file_size(dir + "/tracked.mp4"), 1000u);
   EXPECT_EQ(ReadClip(dir + "/generated.json").num_frames(), 60);
+  // By default each rollout starts from the fit of its stream's first
+  // seconds: a line per rollout says how the fit went, or why it failed.
+  EXPECT_NE(result.output.find("starts and cameras from the fit"),
+            std::string::npos)
+      << result.output;
+  EXPECT_EQ(CountOccurrences(result.output, "fit of its first 30 frames"), 4)
+      << result.output;
+  result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
+                      policy + " --start default --start-fit-s 1 -o " + dir +
+                      "/default.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("starts from the default pose"),
+            std::string::npos)
+      << result.output;
+  EXPECT_EQ(result.output.find("fit of its first"), std::string::npos)
+      << result.output;
   // The tracking options need a tracker.
   result = RunMimic2d("generate " + dir + "/gen --video " + dir + "/x.mp4 -o " +
                       dir + "/x.json");

@@ -172,5 +172,59 @@ TEST(InitialStates, EpisodesStartFromTheBufferedStateUnchanged) {
     EXPECT_NEAR(restored[i], state.qpos[i], 1e-12) << i;
 }
 
+// EstimatedState is the state InitialStates fills from a view's estimate
+// (here the truth's poses and cameras posing as one), and lifts a pose
+// sunk into the floor out of it.
+TEST(InitialStates, AnEstimatedStateIsTheBufferFilledFromTheEstimate) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  SimulationOptions options;
+  auto character = testing::LoadHumanoid(options);
+  ReferenceBundle bundle = testing::MakeWalkBundle(walk_path, *character, 1.0);
+  std::vector<ViewEstimate> estimate(bundle.views.size());
+  for (size_t v = 0; v < bundle.views.size(); ++v) {
+    estimate[v].cameras = bundle.views[v].cameras;
+    estimate[v].skeleton_name = character->skeleton().name;
+    estimate[v].poses = bundle.ground_truth->poses;
+    estimate[v].residual_px.assign(bundle.num_frames(), 0.0);
+  }
+  bundle.estimate = estimate;
+  const std::vector<Pose3D> poses = bundle.ground_truth->poses;
+  TaskSources sources;
+  sources.initial_states = InitialStateSource::kEstimate;
+  sources.cameras = CameraSource::kEstimate;
+  std::vector<ReferenceBundle> bundles;
+  bundles.push_back(std::move(bundle));
+  auto reference = TrackingReference::Prepare(std::move(bundles), *character,
+                                              options.control_hz, sources);
+  InitialStates states(*reference, character, options, StateBufferOptions());
+  for (int t : {0, 7, static_cast<int>(poses.size()) - 1}) {
+    const SimState state = EstimatedState(character, options, poses, t);
+    const SimState& filled = states.buffer(0).entry(t, 0).state;
+    EXPECT_EQ(state.qpos, filled.qpos) << t;
+    EXPECT_EQ(state.qvel, filled.qvel) << t;
+  }
+  // Moving: frame 7's root velocity is the poses' central difference.
+  const SimState middle = EstimatedState(character, options, poses, 7);
+  const int root = character->root_qpos_address();
+  const double vx_m_s =
+      (poses[8].root_position_m.x() - poses[6].root_position_m.x()) *
+      options.control_hz / 2.0;
+  EXPECT_NEAR(middle.qvel[character->root_dof_address()], vx_m_s, 1e-9);
+  EXPECT_GT(std::abs(vx_m_s), 0.3);  // the walk moves
+
+  // Sunk 10 cm: lifted until its lowest point is on the floor.
+  std::vector<Pose3D> sunk = poses;
+  sunk[3].root_position_m.z() -= 0.1;
+  Simulation simulation(character, options);
+  simulation.Restore(EstimatedState(character, options, sunk, 3));
+  EXPECT_NEAR(LowestCharacterPointZ(simulation), 0.0, 1e-9);
+  EXPECT_NEAR(simulation.data()->qpos[root + 2],
+              EstimatedState(character, options, poses, 3).qpos[root + 2],
+              0.1 + 1e-9);
+  EXPECT_THROW(
+      EstimatedState(character, options, poses, static_cast<int>(poses.size())),
+      ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
