@@ -205,7 +205,9 @@ void BM_StreamedRolloutStep(benchmark::State& state) {
       stream = std::make_unique<ClipStream>(view.clip);
       rollout = std::make_unique<StreamedRollout>(
           task.character, options, stream.get(),
-          [&view](int frame, const SimState&) { return view.CameraAt(frame); },
+          [&view](int frame, const SimState&, double) {
+            return view.CameraAt(frame);
+          },
           task.initial_states->BufferOfView(task.view(episode))
               .entry(0, 0)
               .state);

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -136,6 +137,9 @@ struct GenerateArgs {
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
+  // With --policy: track every view of this bundle's (or clip's) 2D instead
+  // of generations, under the same protocol (the control).
+  std::string real;
 };
 
 // The camera at `azimuth_deg` and --view's elevation and distance: the
@@ -181,29 +185,100 @@ void StandingPlacement(const PinholeCamera& camera, Eigen::Vector2d* root_px,
   }
 }
 
-// The first `seconds` of the stream `options` describe, as a clip: the
-// frames the tracker will be handed, drawn by a stream of their own.
-Clip2D FirstFramesOf(const std::string& run_dir,
-                     const GeneratedStreamOptions& options, double seconds) {
-  GeneratedStream stream(run_dir, options);
-  Clip2D clip = stream.format();
+// One stream to track: a generation, or a recorded view (--real).
+struct TrackedSource {
+  std::string label;  // "azimuth 30 deg, generation 2 (seed 2)"
+  std::function<std::unique_ptr<ReferenceStream>()> open;
+  // --start default: the camera the default pose is placed under, and the
+  // first frame's root and scale.
+  PinholeCamera view_camera;
+  Eigen::Vector2d root_px = Eigen::Vector2d::Zero();
+  double scale_px = 0.0;
+};
+
+// The first `seconds` of `source`, as a clip: the frames the tracker will
+// be handed, drawn by a stream of their own.
+Clip2D FirstFramesOf(const TrackedSource& source, double seconds) {
+  std::unique_ptr<ReferenceStream> stream = source.open();
+  Clip2D clip = stream->format();
   const int frames = std::max(1, static_cast<int>(seconds * clip.fps + 0.5));
   const int num_keypoints = clip.layout->num_keypoints();
   clip.keypoints = KeypointTrack(frames, num_keypoints);
   std::vector<Keypoint2D> frame;
-  for (int t = 0; t < frames && stream.Next(&frame); ++t) {
-    for (int j = 0; j < num_keypoints; ++j) clip.keypoints.at(t, j) = frame[j];
+  int read = 0;
+  while (read < frames && stream->Next(&frame)) {
+    for (int j = 0; j < num_keypoints; ++j)
+      clip.keypoints.at(read, j) = frame[j];
+    ++read;
   }
+  if (read < frames) clip.keypoints = KeypointTrack(0, num_keypoints);
   return clip;
 }
 
-// The checkpoint's tracker along `args.generations` generated streams seen
-// from --view. Each starts where args.start says (by default the fit of the
-// stream's first seconds: its first pose, seen by its first camera); the
-// camera then dollies with the simulated character (the generator learned
-// from cameras that followed the subject). A rollout succeeds when it
-// tracks --seconds without an early exit. Prints a line per generation and
-// the totals; draws the first with --video.
+// The streams --policy tracks: --generations generations from every
+// azimuth, or with --real every view of a recorded bundle's 2D (the same
+// protocol on real motion: the control the generated figures are read
+// against).
+std::vector<TrackedSource> TrackedSources(const GenerateArgs& args) {
+  std::vector<TrackedSource> sources;
+  if (!args.real.empty()) {
+    auto bundle = std::make_shared<const ReferenceBundle>(
+        ReadBundleOrClip(args.real));  // the 2D only: no camera, no 3D
+    for (size_t v = 0; v < bundle->views.size(); ++v) {
+      TrackedSource source;
+      source.label = "real " + bundle->name + " " + bundle->views[v].name;
+      source.open = [bundle, v] {
+        return std::make_unique<ClipStream>(bundle->views[v].clip);
+      };
+      sources.push_back(std::move(source));
+    }
+    return sources;
+  }
+  const GenConfig generator_config = ReadPriorConfig(args.run_dir);
+  const std::vector<double> azimuths_deg =
+      args.azimuths_deg.empty() ? std::vector<double>{args.view[0]}
+                                : args.azimuths_deg;
+  for (double azimuth_deg : azimuths_deg) {
+    const PinholeCamera view_camera = ViewCamera(args, azimuth_deg);
+    Eigen::Vector2d root_px;
+    double scale_px = 0.0;
+    StandingPlacement(view_camera, &root_px, &scale_px);
+    for (int g = 0; g < args.generations; ++g) {
+      GeneratedStreamOptions options;
+      options.generation = args.generation;
+      options.generation.seed = args.generation.seed + g;
+      options.generation.view =
+          GenerationView(generator_config, azimuth_deg, args.view[1]);
+      options.first_root_px = root_px;
+      options.first_scale_px = scale_px;
+      options.image_width_px = view_camera.intrinsics().width_px;
+      options.image_height_px = view_camera.intrinsics().height_px;
+      TrackedSource source;
+      char label[128];
+      std::snprintf(label, sizeof(label),
+                    "azimuth %.0f deg, generation %d (seed %llu)", azimuth_deg,
+                    g + 1,
+                    static_cast<unsigned long long>(options.generation.seed));
+      source.label = label;
+      source.open = [run_dir = args.run_dir, options] {
+        return std::make_unique<GeneratedStream>(run_dir, options);
+      };
+      source.view_camera = view_camera;
+      source.root_px = root_px;
+      source.scale_px = scale_px;
+      sources.push_back(std::move(source));
+    }
+  }
+  return sources;
+}
+
+// The checkpoint's tracker along every stream of TrackedSources. Each
+// starts where args.start says (by default the fit of the stream's first
+// seconds: its first pose, seen by its first camera); the camera then
+// dollies with the simulated character (the generator learned from cameras
+// that followed the subject). A rollout succeeds when it tracks --seconds
+// without an early exit. Prints a line per stream and the totals; draws
+// the first with --video.
 int RunTrackedGenerations(const GenerateArgs& args) {
   TorchPolicy policy(args.policy);
   const TrainConfig& config = policy.config();
@@ -212,20 +287,15 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   TrackingEnvOptions env_options = config.env;
   env_options.max_episode_s = args.seconds;
   const int root = character->root_qpos_address();
-  const GenConfig generator_config = ReadPriorConfig(args.run_dir);
-  const std::vector<double> azimuths_deg =
-      args.azimuths_deg.empty() ? std::vector<double>{args.view[0]}
-                                : args.azimuths_deg;
+  const int root_dof = character->root_dof_address();  // world-frame velocity
+  const std::vector<TrackedSource> sources = TrackedSources(args);
   FitOptions fit_options;  // the stream's first seconds as a user's clip
   fit_options.camera_motion = CameraMotion::kMoving;
   fit_options.fixed_focal_px = args.focal_px;
   fit_options.num_threads = 1;
   fit_options.Validate();
-  std::printf(
-      "tracking with %s: %d generation(s) x %.0f s x %zu view(s) (elevation "
-      "%.0f deg, %.1f m)\n",
-      args.policy.c_str(), args.generations, args.seconds, azimuths_deg.size(),
-      args.view[1], args.view[2]);
+  std::printf("tracking with %s: %zu stream(s) x %.0f s\n", args.policy.c_str(),
+              sources.size(), args.seconds);
   if (args.start == GeneratedStart::kFit) {
     std::printf(
         "starts and cameras from the fit of each stream's first %.1f s "
@@ -235,121 +305,107 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   } else {
     std::printf(
         "starts from the default pose placed under the first generated frame "
-        "(no 3D), cameras the chosen view dollying with the character\n");
+        "(no 3D), cameras the chosen view (elevation %.0f deg, %.1f m) "
+        "dollying with the character\n",
+        args.view[1], args.view[2]);
   }
   int succeeded = 0, rollouts = 0, unfitted = 0;
   double e2d_sum_px = 0.0;
-  for (double azimuth_deg : azimuths_deg) {
-    const PinholeCamera view_camera = ViewCamera(args, azimuth_deg);
-    Eigen::Vector2d root_px;
-    double scale_px = 0.0;
-    StandingPlacement(view_camera, &root_px, &scale_px);
-    for (int g = 0; g < args.generations; ++g) {
-      GeneratedStreamOptions stream_options;
-      stream_options.generation = args.generation;
-      stream_options.generation.seed = args.generation.seed + g;
-      stream_options.generation.view =
-          GenerationView(generator_config, azimuth_deg, args.view[1]);
-      stream_options.first_root_px = root_px;
-      stream_options.first_scale_px = scale_px;
-      stream_options.image_width_px = view_camera.intrinsics().width_px;
-      stream_options.image_height_px = view_camera.intrinsics().height_px;
-
-      // The start and the first camera.
-      SimState start;
-      PinholeCamera first_camera = view_camera;
-      if (args.start == GeneratedStart::kFit) {
-        const Clip2D first_frames =
-            FirstFramesOf(args.run_dir, stream_options, args.start_fit_s);
-        const std::string source =
-            "generation " + std::to_string(g + 1) + " (azimuth " +
-            std::to_string(static_cast<int>(azimuth_deg)) + " deg)";
-        ViewEstimate estimate;
-        try {
-          estimate = FitView(first_frames, *character, fit_options, source);
-        } catch (const InputError& e) {
-          // Generated 2D a fit cannot use (a person leaving the image, too
-          // few frames): that generation is lost, the others still run.
-          std::printf(
-              "  fit of its first %d frames failed (%s): azimuth %.0f deg, "
-              "generation %d counted as lost\n",
-              first_frames.num_frames(), e.what(), azimuth_deg, g + 1);
-          ++unfitted;
-          continue;
-        }
-        start =
-            EstimatedState(character, config.env.simulation, estimate.poses, 0);
-        first_camera = estimate.CameraAt(0);
+  for (const TrackedSource& source : sources) {
+    // The start and the first camera.
+    SimState start;
+    PinholeCamera first_camera = source.view_camera;
+    if (args.start == GeneratedStart::kFit) {
+      const Clip2D first_frames = FirstFramesOf(source, args.start_fit_s);
+      ViewEstimate estimate;
+      try {
+        estimate = FitView(first_frames, *character, fit_options, source.label);
+      } catch (const InputError& e) {
+        // 2D a fit cannot use (a person leaving the image, a stream
+        // shorter than the fitted seconds): that stream is lost, the
+        // others still run.
         std::printf(
-            "  fit of its first %d frames: %.1f px, %s\n",
-            first_frames.num_frames(), estimate.summary.mean_reprojection_px,
-            estimate.summary.converged() ? "every frame converged"
-                                         : "some frames did not converge");
-      } else {
-        start = PlacedDefaultState(character, config.env.simulation,
-                                   view_camera, {root_px, scale_px});
+            "  fit of its first %d frames failed (%s): %s counted as "
+            "lost\n",
+            first_frames.num_frames(), e.what(), source.label.c_str());
+        ++unfitted;
+        continue;
       }
-      GeneratedStream stream(args.run_dir, stream_options);
-      StreamedRollout rollout(
-          character, env_options, &stream,
-          [&](int, const SimState& state) {
-            return first_camera.Translated(
-                {state.qpos[root] - start.qpos[root],
-                 state.qpos[root + 1] - start.qpos[root + 1], 0.0});
-          },
-          start);
-      const bool draw = rollouts == 0 && !args.video.empty();
-      std::vector<EpisodeFrame> frames;
-      auto record = [&] {
-        if (!draw) return;
-        EpisodeFrame frame;
-        frame.clip_frame = rollout.frame();
-        frame.camera = rollout.camera();
-        frame.reference = rollout.reference_frame();
-        frame.state = rollout.simulation().Save();
-        frames.push_back(std::move(frame));
-      };
-      record();
-      const auto started = std::chrono::steady_clock::now();
-      while (rollout.Step(policy)) record();
-      record();
-      const double wall_s = std::chrono::duration<double>(
-                                std::chrono::steady_clock::now() - started)
-                                .count();
-      const EpisodeStats& stats = rollout.stats();
-      ++rollouts;
-      succeeded += stats.failed ? 0 : 1;
-      e2d_sum_px += stats.mean_error_px();
+      start =
+          EstimatedState(character, config.env.simulation, estimate.poses, 0);
+      first_camera = estimate.CameraAt(0);
       std::printf(
-          "  azimuth %.0f deg, generation %d (seed %llu): %s after %d of %d "
-          "frames, E2D %.1f px, %.0fx real time\n",
-          azimuth_deg, g + 1,
-          static_cast<unsigned long long>(stream_options.generation.seed),
-          stats.failed ? "lost (early exit)" : "tracked to the end",
-          stats.steps, env_options.max_episode_steps(), stats.mean_error_px(),
-          stats.steps / config.env.simulation.control_hz /
-              std::max(1e-9, wall_s));
-      std::fflush(stdout);
-      if (!draw) continue;
-      RecordedFrames recorded(std::move(frames));
-      const Clip2D& format = stream.format();
-      BundleReplayOptions replay;
-      replay.output.video_path = args.video;
-      EpisodeRenderOptions render;
-      render.pose_label = "character (policy)";
-      render.reference_label = "generated 2D";
-      const EpisodeSummary summary =
-          RenderViewFrames(recorded, character, config.env.simulation, format,
-                           format.fps, render, replay);
-      std::printf("  wrote %s (%d frames)\n", summary.video_path.c_str(),
-                  summary.frames_rendered);
+          "  fit of its first %d frames: %.1f px, %s\n",
+          first_frames.num_frames(), estimate.summary.mean_reprojection_px,
+          estimate.summary.converged() ? "every frame converged"
+                                       : "some frames did not converge");
+    } else {
+      start = PlacedDefaultState(character, config.env.simulation,
+                                 source.view_camera,
+                                 {source.root_px, source.scale_px});
     }
+    std::unique_ptr<ReferenceStream> stream = source.open();
+    StreamedRollout rollout(
+        character, env_options, stream.get(),
+        [&](int, const SimState& state, double lead_s) {
+          // Where the character's root will be at the frame's time.
+          return first_camera.Translated(
+              {state.qpos[root] + state.qvel[root_dof] * lead_s -
+                   start.qpos[root],
+               state.qpos[root + 1] + state.qvel[root_dof + 1] * lead_s -
+                   start.qpos[root + 1],
+               0.0});
+        },
+        start);
+    const bool draw = rollouts == 0 && !args.video.empty();
+    std::vector<EpisodeFrame> frames;
+    auto record = [&] {
+      if (!draw) return;
+      EpisodeFrame frame;
+      frame.clip_frame = rollout.frame();
+      frame.camera = rollout.camera();
+      frame.reference = rollout.reference_frame();
+      frame.state = rollout.simulation().Save();
+      frames.push_back(std::move(frame));
+    };
+    record();
+    const auto started = std::chrono::steady_clock::now();
+    while (rollout.Step(policy)) record();
+    record();
+    const double wall_s = std::chrono::duration<double>(
+                              std::chrono::steady_clock::now() - started)
+                              .count();
+    const EpisodeStats& stats = rollout.stats();
+    ++rollouts;
+    succeeded += stats.failed ? 0 : 1;
+    e2d_sum_px += stats.mean_error_px();
+    std::printf(
+        "  %s: %s after %d of %d frames, E2D %.1f px, %.0fx real time\n",
+        source.label.c_str(),
+        stats.failed ? "lost (early exit)" : "tracked to the end", stats.steps,
+        env_options.max_episode_steps(), stats.mean_error_px(),
+        stats.steps / config.env.simulation.control_hz /
+            std::max(1e-9, wall_s));
+    std::fflush(stdout);
+    if (!draw) continue;
+    RecordedFrames recorded(std::move(frames));
+    const Clip2D& format = stream->format();
+    BundleReplayOptions replay;
+    replay.output.video_path = args.video;
+    EpisodeRenderOptions render;
+    render.pose_label = "character (policy)";
+    render.reference_label = args.real.empty() ? "generated 2D" : "real 2D";
+    const EpisodeSummary summary =
+        RenderViewFrames(recorded, character, config.env.simulation, format,
+                         format.fps, render, replay);
+    std::printf("  wrote %s (%d frames)\n", summary.video_path.c_str(),
+                summary.frames_rendered);
   }
-  // A generation whose start could not be fitted counts as lost; E2D is
-  // over the rollouts that ran.
+  // A stream whose start could not be fitted counts as lost; E2D is over
+  // the rollouts that ran.
   const int total = rollouts + unfitted;
   std::printf("Succ %d/%d (%.0f %%), mean E2D %.1f px", succeeded, total,
-              100.0 * succeeded / total,
+              100.0 * succeeded / std::max(1, total),
               rollouts > 0 ? e2d_sum_px / rollouts : 0.0);
   if (unfitted > 0) std::printf(", %d not started (fit failed)", unfitted);
   std::printf("\n");
@@ -360,9 +416,14 @@ int RunGenerate(const GenerateArgs& args) {
   if (args.view.size() != 3)
     throw ConfigError("generate: --view takes azimuth,elevation,distance");
   if (args.policy.empty() && (!args.video.empty() || args.generations != 1 ||
-                              !args.azimuths_deg.empty()))
+                              !args.azimuths_deg.empty() || !args.real.empty()))
     throw ConfigError(
-        "generate: --video, --generations and --azimuths need --policy");
+        "generate: --video, --generations, --azimuths and --real need "
+        "--policy");
+  if (!args.real.empty() && args.start != GeneratedStart::kFit)
+    throw ConfigError(
+        "generate: --real needs --start fit (a recorded view's 2D has no "
+        "camera to place the default pose under)");
   // A prior conditioned on the view generates the data's view nearest to
   // --view.
   const GenConfig config = ReadPriorConfig(args.run_dir);
@@ -598,6 +659,12 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
               {"fit", GeneratedStart::kFit},
               {"default", GeneratedStart::kDefault}},
           CLI::ignore_case));
+  generate
+      ->add_option("--real", generate_args->real,
+                   "With --policy: track every view of this bundle's (or "
+                   "clip's) 2D instead of generations, under the same "
+                   "protocol (fitted start, following camera): the control")
+      ->check(CLI::ExistingFile);
   generate
       ->add_option("--start-fit-s", generate_args->start_fit_s,
                    "With --start fit: seconds of each stream fitted")

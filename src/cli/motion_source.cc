@@ -76,6 +76,12 @@ void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
       ->capture_default_str();
   command.add_flag("--follow", *follow,
                    "Cameras dolly along with the subject's ground path");
+  command
+      .add_option("--follow-smoothing", options->follow_smoothing_s,
+                  "With --follow: the path is averaged over this window (s); "
+                  "0 follows the root itself")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
   command.add_option("--noise-px", options->noise.pixel_sigma_px,
                      "Detector noise: Gaussian sigma (px)");
   command.add_option("--drop", options->noise.drop_probability,

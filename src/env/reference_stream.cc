@@ -48,8 +48,8 @@ StreamedRollout::StreamedRollout(std::shared_ptr<const Character> character,
 }
 
 bool StreamedRollout::FillWindow() {
-  // Outline: frames enter at the back, each with its camera, until the
-  // current frame and its L future frames are in.
+  // Outline: frames enter at the back until the current frame and its L
+  // future frames are in.
   const size_t wanted = options_.num_future_frames + 1;
   std::vector<Keypoint2D> keypoints;
   while (window_.size() < wanted && !stream_ended_) {
@@ -65,18 +65,25 @@ bool StreamedRollout::FillWindow() {
               std::to_string(keypoints.size()) + " keypoints, the layout " +
               std::to_string(character_->keypoint_layout().num_keypoints()));
     }
-    cameras_.push_back(
-        camera_(frame_ + static_cast<int>(window_.size()), state_));
     window_.push_back(keypoints);
   }
   return window_.size() >= 2;
 }
 
+void StreamedRollout::AskCameras(const SimState& state) {
+  const double dt_s = 1.0 / options_.simulation.control_hz;
+  cameras_.clear();
+  for (size_t t = 0; t < window_.size(); ++t) {
+    cameras_.push_back(camera_(frame_ + static_cast<int>(t), state, t * dt_s));
+  }
+}
+
 void StreamedRollout::Restart(const SimState& state) {
-  // Outline: the window as a one-view bundle with per-frame cameras,
-  // prepared as any reference is (cameras: truth, the bundle's own), then
-  // the TrackingEnv moved onto it (made once), reset to the window's first
-  // frame at `state`.
+  // Outline: the window as a one-view bundle with per-frame cameras (asked
+  // at `state`), prepared as any reference is (cameras: truth, the bundle's
+  // own), then the TrackingEnv moved onto it (made once), reset to the
+  // window's first frame at `state`.
+  AskCameras(state);
   const Clip2D& format = stream_->format();
   ReferenceBundle bundle;
   bundle.name = "stream";

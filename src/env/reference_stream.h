@@ -42,11 +42,12 @@ class ClipStream : public ReferenceStream {
   int next_frame_ = 0;
 };
 
-// The camera that sees frame `frame`, given the simulation's state when the
-// frame enters the rollout's window: a recorded view's camera of that
-// frame, or one that dollies with the simulated character.
-using StreamCamera =
-    std::function<PinholeCamera(int frame, const SimState& state)>;
+// The camera that sees frame `frame` when the simulation is at `state` and
+// the frame lies `lead_s` seconds ahead of it: a recorded view's camera of
+// that frame (state and lead unused), or one that dollies with the
+// simulated character (where the character will be at the frame's time).
+using StreamCamera = std::function<PinholeCamera(
+    int frame, const SimState& state, double lead_s)>;
 
 // One tracker rollout along a stream. Each control step prepares the
 // frames it observes (the current one and the L future ones) as a
@@ -54,9 +55,12 @@ using StreamCamera =
 // (Rebase), restarts it from the simulation's current state, and steps it;
 // observation, reward and early exit are the environment's own, so a recorded
 // clip streamed this way rolls out exactly as the same clip prepared whole
-// (tested). The camera of each frame is asked for when the frame enters the
-// window, so a camera that follows the character lags it by up to L frames.
-// Object tracks are not streamed.
+// (tested). The window's cameras are asked for again at every restart, from
+// the state the step starts at: the step projects the character with the
+// next frame's camera, asked one control period ahead. (Asked once, when a
+// frame entered the window, a camera following the character lagged it by
+// L frames: at walking speed 20 cm, a 20-45 px offset the tracker chased
+// until it fell.) Object tracks are not streamed.
 class StreamedRollout {
  public:
   // `options.max_episode_s` and `options.early_exit` apply as in training;
@@ -83,6 +87,8 @@ class StreamedRollout {
   // Reads frames until the window [frame_, frame_ + L] is full or the
   // stream ends; false when not even frame_ + 1 exists.
   bool FillWindow();
+  // Each window frame's camera, asked at `state`.
+  void AskCameras(const SimState& state);
   // The TrackingEnv on the window, started from `state`.
   void Restart(const SimState& state);
 

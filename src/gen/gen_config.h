@@ -39,6 +39,9 @@ struct GenDataOptions {
     v("distance_m", self.views.distance_m, Range::Above(0.1),
       "camera to subject (m)");
     v("focal_px", self.views.focal_px, Range::Above(0), "focal length (px)");
+    v("follow_smoothing_s", self.views.follow_smoothing_s, Range::Closed(0, 60),
+      "the dolly follows the subject's ground path averaged over this (s); "
+      "0: the root itself");
   }
   void Validate() const;  // throws ConfigError
 };

@@ -122,6 +122,8 @@ void GenViewOptions::Validate() const {
     if (!(elevation > -80.0 && elevation < 80.0))
       throw ConfigError("views: elevations_deg must lie in (-80, 80)");
   }
+  if (!(follow_smoothing_s >= 0.0 && follow_smoothing_s <= 60.0))
+    throw ConfigError("views: follow_smoothing_s must be in [0, 60] s");
   RigOptions rig;
   rig.distance_m = distance_m;
   rig.focal_px = focal_px;
@@ -294,6 +296,7 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
       if (source.motion.loops)
         options.duration_s = std::max(source.motion.duration_s(), loop_to_s);
       options.follow = CameraFollow::kRootDolly;
+      options.follow_smoothing_s = views.follow_smoothing_s;
       options.rig.num_views = views.num_azimuths;
       options.rig.elevation_deg = elevation;
       options.rig.distance_m = views.distance_m;

@@ -48,6 +48,11 @@ struct GenViewOptions {
   std::vector<double> elevations_deg = {0, 20};  // camera elevations
   double distance_m = 4.5;                       // camera to subject
   double focal_px = 1000.0;
+  // The dolly follows the subject's ground path averaged over this window
+  // (s). 0: the root itself, so the subject's image root stays where it
+  // started, as under a camera that follows a simulated character
+  // (`generate --policy`).
+  double follow_smoothing_s = 1.0;
   int width_px = 1920;
   int height_px = 1080;
 

@@ -131,9 +131,38 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
       << result.output;
   EXPECT_EQ(result.output.find("fit of its first"), std::string::npos)
       << result.output;
+
+  // --real: the same protocol on a recorded walk's 2D (a dolly on the root,
+  // as the rollout's camera follows the character), the control the
+  // generated figures are read against: the walk2d tracker follows it.
+  result = RunMimic2d(
+      "clip from-motion " +
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+      " --views 2 --duration 4 --follow --follow-smoothing 0 -o " + dir +
+      "/real.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  result =
+      RunMimic2d("generate " + dir + "/gen --seconds 3 --policy " + policy +
+                 " --real " + dir + "/real.json -o " + dir + "/unused.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(CountOccurrences(result.output, "tracked to the end"), 2)
+      << result.output;
+  EXPECT_NE(result.output.find("Succ 2/2"), std::string::npos) << result.output;
+  // A recorded view has no camera to place the default pose under.
+  result =
+      RunMimic2d("generate " + dir + "/gen --policy " + policy + " --real " +
+                 dir + "/real.json --start default -o " + dir + "/unused.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--real needs --start fit"), std::string::npos)
+      << result.output;
   // The tracking options need a tracker.
   result = RunMimic2d("generate " + dir + "/gen --video " + dir + "/x.mp4 -o " +
                       dir + "/x.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("need --policy"), std::string::npos)
+      << result.output;
+  result = RunMimic2d("generate " + dir + "/gen --real " + dir +
+                      "/real.json -o " + dir + "/x.json");
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("need --policy"), std::string::npos)
       << result.output;

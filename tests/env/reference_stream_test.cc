@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "common/error.h"
@@ -68,7 +69,7 @@ bool ExpectStreamedRolloutMatchesWhole(const std::string& motion_path,
   int camera_calls = 0;
   StreamedRollout rollout(
       task.character, task.options, &stream,
-      [&](int frame, const SimState&) {
+      [&](int frame, const SimState&, double) {
         ++camera_calls;
         return view.CameraAt(frame);
       },
@@ -97,8 +98,8 @@ bool ExpectStreamedRolloutMatchesWhole(const std::string& motion_path,
   EXPECT_NEAR(rollout.stats().mean_error_px(), env.episode().mean_error_px(),
               1e-6);
   EXPECT_NEAR(rollout.stats().max_error_px, env.episode().max_error_px, 1e-6);
-  // Every frame's camera asked for once, as it entered the window.
-  EXPECT_LE(camera_calls, view.clip.num_frames());
+  // The window's cameras asked for at every restart: L + 1 frames or fewer.
+  EXPECT_LE(camera_calls, (task.options.num_future_frames + 1) * (steps + 1));
   EXPECT_GE(camera_calls, steps + 1);
   return env.episode().failed;
 }
@@ -120,7 +121,7 @@ TEST(StreamedRollout, ShortOrMisshapenStreamsAreNamedErrors) {
   const ReferenceView& view = task.reference->bundles()[0].views[0];
   std::mt19937_64 rng(3);
   const SimState start = task.initial_states->BufferOfView(0).Draw(0, rng);
-  auto camera = [&](int frame, const SimState&) {
+  auto camera = [&](int frame, const SimState&, double) {
     return view.CameraAt(frame);
   };
   Clip2D one_frame = view.clip;
@@ -156,6 +157,59 @@ TEST(StreamedRollout, ShortOrMisshapenStreamsAreNamedErrors) {
     EXPECT_NE(std::string(e.what()).find("has 12 keypoints"), std::string::npos)
         << e.what();
   }
+}
+
+// A camera that dollies with the simulated character is asked, for the
+// frame a step lands on, one control period ahead, from the state the step
+// starts at: it sees the character where it is, not where it was L frames
+// ago (20 cm back at walking speed, before 2026-11-26).
+TEST(StreamedRollout, AFollowingCameraIsAskedWhereTheCharacterWillBe) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 1.0);
+  const ReferenceView& view = task.reference->bundles()[0].views[0];
+  std::mt19937_64 rng(3);
+  const SimState start = task.initial_states->BufferOfView(0).Draw(0, rng);
+  const int root = task.character->root_qpos_address();
+  const int root_dof = task.character->root_dof_address();
+  const double dt_s = 1.0 / task.options.simulation.control_hz;
+  // frame -> the root (x, y) predicted for it at lead dt.
+  std::map<int, Eigen::Vector2d> predicted;
+  auto camera = [&](int frame, const SimState& state, double lead_s) {
+    const Eigen::Vector2d root_m(
+        state.qpos[root] + state.qvel[root_dof] * lead_s,
+        state.qpos[root + 1] + state.qvel[root_dof + 1] * lead_s);
+    if (std::abs(lead_s - dt_s) < 1e-12) predicted[frame] = root_m;
+    return view.CameraAt(0).Translated(
+        {root_m.x() - start.qpos[root], root_m.y() - start.qpos[root + 1], 0});
+  };
+  ClipStream stream(view.clip);
+  StreamedRollout rollout(task.character, task.options, &stream, camera, start);
+  TrackingEnv sizes(task.character, task.reference, task.initial_states,
+                    task.options, 0);
+  testing::ZeroPolicy controller(sizes.observation_size(), sizes.action_size());
+  const Eigen::Vector3d offset_m =
+      view.CameraAt(0).CenterWorld() -
+      Eigen::Vector3d(start.qpos[root], start.qpos[root + 1], 0);
+  int steps = 0;
+  double worst_lag_m = 0.0, travel_m = 0.0;
+  Eigen::Vector2d first_root(start.qpos[root], start.qpos[root + 1]);
+  while (rollout.Step(controller) && steps < 20) {
+    ++steps;
+    const double* qpos = rollout.simulation().data()->qpos;
+    const Eigen::Vector2d root_m(qpos[root], qpos[root + 1]);
+    // The current frame's camera sits at the character's root.
+    const Eigen::Vector3d center = rollout.camera().CenterWorld();
+    EXPECT_NEAR(center.x() - offset_m.x(), root_m.x(), 1e-9);
+    EXPECT_NEAR(center.y() - offset_m.y(), root_m.y(), 1e-9);
+    // The camera the step projected with was asked one period ahead.
+    ASSERT_EQ(predicted.count(rollout.frame()), 1u) << rollout.frame();
+    worst_lag_m =
+        std::max(worst_lag_m, (predicted[rollout.frame()] - root_m).norm());
+    travel_m = (root_m - first_root).norm();
+  }
+  ASSERT_GE(steps, 10);
+  EXPECT_GT(travel_m, 0.1);      // the walk's start carries it forward
+  EXPECT_LT(worst_lag_m, 0.02);  // one step's prediction, not L frames back
 }
 
 }  // namespace
