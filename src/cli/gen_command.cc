@@ -2,6 +2,7 @@
 // prior) from a config; `mimic2d generate` — stream generated 2D motion into
 // a clip placed under a chosen camera view.
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -137,6 +138,9 @@ struct GenerateArgs {
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
+  // With kFit: the rollout starts this far into the stream (s), from the
+  // fit's pose there; the frames before it are not tracked.
+  double start_at_s = 0.0;
   // With --policy: track every view of this bundle's (or clip's) 2D instead
   // of generations, under the same protocol (the control).
   std::string real;
@@ -299,9 +303,9 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   if (args.start == GeneratedStart::kFit) {
     std::printf(
         "starts and cameras from the fit of each stream's first %.1f s "
-        "(moving camera, focal %.0f px; no 3D), the camera dollying with the "
-        "character\n",
-        args.start_fit_s, args.focal_px);
+        "(moving camera, focal %.0f px; no 3D), at %.1f s into it, the camera "
+        "dollying with the character\n",
+        args.start_fit_s, args.focal_px, args.start_at_s);
   } else {
     std::printf(
         "starts from the default pose placed under the first generated frame "
@@ -312,8 +316,9 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   int succeeded = 0, rollouts = 0, unfitted = 0;
   double e2d_sum_px = 0.0;
   for (const TrackedSource& source : sources) {
-    // The start and the first camera.
+    // The start, its frame and the first camera.
     SimState start;
+    int start_frame = 0;
     PinholeCamera first_camera = source.view_camera;
     if (args.start == GeneratedStart::kFit) {
       const Clip2D first_frames = FirstFramesOf(source, args.start_fit_s);
@@ -331,9 +336,13 @@ int RunTrackedGenerations(const GenerateArgs& args) {
         ++unfitted;
         continue;
       }
-      start =
-          EstimatedState(character, config.env.simulation, estimate.poses, 0);
-      first_camera = estimate.CameraAt(0);
+      // The fitted window's frame the rollout starts at.
+      start_frame = std::min(
+          first_frames.num_frames() - 1,
+          static_cast<int>(std::lround(args.start_at_s * first_frames.fps)));
+      start = EstimatedState(character, config.env.simulation, estimate.poses,
+                             start_frame);
+      first_camera = estimate.CameraAt(start_frame);
       std::printf(
           "  fit of its first %d frames: %.1f px, %s\n",
           first_frames.num_frames(), estimate.summary.mean_reprojection_px,
@@ -345,6 +354,8 @@ int RunTrackedGenerations(const GenerateArgs& args) {
                                  {source.root_px, source.scale_px});
     }
     std::unique_ptr<ReferenceStream> stream = source.open();
+    std::vector<Keypoint2D> skipped;
+    for (int t = 0; t < start_frame; ++t) stream->Next(&skipped);
     StreamedRollout rollout(
         character, env_options, stream.get(),
         [&](int, const SimState& state, double lead_s) {
@@ -420,6 +431,12 @@ int RunGenerate(const GenerateArgs& args) {
     throw ConfigError(
         "generate: --video, --generations, --azimuths and --real need "
         "--policy");
+  if (args.start_at_s > 0.0 && args.start != GeneratedStart::kFit)
+    throw ConfigError(
+        "generate: --start-at-s needs --start fit (the fit's pose there)");
+  if (!(args.start_at_s < args.start_fit_s))
+    throw ConfigError(
+        "generate: --start-at-s must lie within the fitted --start-fit-s");
   if (!args.real.empty() && args.start != GeneratedStart::kFit)
     throw ConfigError(
         "generate: --real needs --start fit (a recorded view's 2D has no "
@@ -669,6 +686,13 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->add_option("--start-fit-s", generate_args->start_fit_s,
                    "With --start fit: seconds of each stream fitted")
       ->check(CLI::Range(0.5, 60.0));
+  generate
+      ->add_option("--start-at-s", generate_args->start_at_s,
+                   "With --start fit: start this far into the stream, from "
+                   "the fit's pose there (an edge of the fitted window is "
+                   "its least constrained frame; the prior's first codes "
+                   "come from the start token alone)")
+      ->check(CLI::Range(0.0, 60.0));
   generate->callback([run, generate_args] {
     *run = [generate_args] { return RunGenerate(*generate_args); };
   });

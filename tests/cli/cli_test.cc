@@ -141,13 +141,23 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
       " --views 2 --duration 4 --follow --follow-smoothing 0 -o " + dir +
       "/real.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  result =
-      RunMimic2d("generate " + dir + "/gen --seconds 3 --policy " + policy +
-                 " --real " + dir + "/real.json -o " + dir + "/unused.json");
+  result = RunMimic2d("generate " + dir + "/gen --seconds 3 --policy " +
+                      policy + " --real " + dir +
+                      "/real.json --start-at-s 0.5 -o " + dir + "/unused.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(CountOccurrences(result.output, "tracked to the end"), 2)
       << result.output;
   EXPECT_NE(result.output.find("Succ 2/2"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("at 0.5 s into it"), std::string::npos)
+      << result.output;
+  // The start lies within the fitted seconds.
+  result =
+      RunMimic2d("generate " + dir + "/gen --policy " + policy +
+                 " --start-fit-s 1 --start-at-s 1 -o " + dir + "/unused.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("within the fitted --start-fit-s"),
+            std::string::npos)
+      << result.output;
   // A recorded view has no camera to place the default pose under.
   result =
       RunMimic2d("generate " + dir + "/gen --policy " + policy + " --real " +
