@@ -139,12 +139,22 @@ struct GenerateArgs {
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
   // With kFit: the rollout starts this far into the stream (s), from the
-  // fit's pose there; the frames before it are not tracked.
-  double start_at_s = 0.0;
+  // fit's pose there; the frames before it are not tracked. Negative: the
+  // middle of the fitted seconds (StartAtS).
+  double start_at_s = -1.0;
   // With --policy: track every view of this bundle's (or clip's) 2D instead
   // of generations, under the same protocol (the control).
   std::string real;
 };
+
+// Where a fitted start lies in the stream (s): --start-at-s, by default
+// the middle of the fitted seconds. A window's edge is its least
+// constrained frame, and the prior's first codes follow the start token
+// alone: started at 1 s of 2 instead of 0, the walk2d tracker followed 26
+// of 40 generated walks for 60 s instead of 20 (docs/generation.md 4b).
+double StartAtS(const GenerateArgs& args) {
+  return args.start_at_s >= 0.0 ? args.start_at_s : 0.5 * args.start_fit_s;
+}
 
 // The camera at `azimuth_deg` and --view's elevation and distance: the
 // rig's, aimed at the origin.
@@ -305,7 +315,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
         "starts and cameras from the fit of each stream's first %.1f s "
         "(moving camera, focal %.0f px; no 3D), at %.1f s into it, the camera "
         "dollying with the character\n",
-        args.start_fit_s, args.focal_px, args.start_at_s);
+        args.start_fit_s, args.focal_px, StartAtS(args));
   } else {
     std::printf(
         "starts from the default pose placed under the first generated frame "
@@ -339,7 +349,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
       // The fitted window's frame the rollout starts at.
       start_frame = std::min(
           first_frames.num_frames() - 1,
-          static_cast<int>(std::lround(args.start_at_s * first_frames.fps)));
+          static_cast<int>(std::lround(StartAtS(args) * first_frames.fps)));
       start = EstimatedState(character, config.env.simulation, estimate.poses,
                              start_frame);
       first_camera = estimate.CameraAt(start_frame);
@@ -431,10 +441,10 @@ int RunGenerate(const GenerateArgs& args) {
     throw ConfigError(
         "generate: --video, --generations, --azimuths and --real need "
         "--policy");
-  if (args.start_at_s > 0.0 && args.start != GeneratedStart::kFit)
+  if (args.start_at_s >= 0.0 && args.start != GeneratedStart::kFit)
     throw ConfigError(
         "generate: --start-at-s needs --start fit (the fit's pose there)");
-  if (!(args.start_at_s < args.start_fit_s))
+  if (!(StartAtS(args) < args.start_fit_s))
     throw ConfigError(
         "generate: --start-at-s must lie within the fitted --start-fit-s");
   if (!args.real.empty() && args.start != GeneratedStart::kFit)
@@ -691,7 +701,8 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "With --start fit: start this far into the stream, from "
                    "the fit's pose there (an edge of the fitted window is "
                    "its least constrained frame; the prior's first codes "
-                   "come from the start token alone)")
+                   "come from the start token alone; default: the middle "
+                   "of the fitted seconds)")
       ->check(CLI::Range(0.0, 60.0));
   generate->callback([run, generate_args] {
     *run = [generate_args] { return RunGenerate(*generate_args); };

@@ -122,6 +122,9 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
       << result.output;
   EXPECT_EQ(CountOccurrences(result.output, "fit of its first 30 frames"), 4)
       << result.output;
+  // and starts in the middle of the fitted seconds.
+  EXPECT_NE(result.output.find("at 0.5 s into it"), std::string::npos)
+      << result.output;
   result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
                       policy + " --start default --start-fit-s 1 -o " + dir +
                       "/default.json");
