@@ -30,10 +30,6 @@ void GptOptions::Validate() const {
   CheckRanges(*this, "prior");
   if (embedding % num_heads != 0)
     throw ConfigError("prior.embedding must be a multiple of prior.num_heads");
-  if (view_in_every_token && !condition_on_view)
-    throw ConfigError(
-        "prior.view_in_every_token needs prior.condition_on_view (there is "
-        "no view to add)");
 }
 
 void GenConfig::Validate() const {

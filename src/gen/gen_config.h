@@ -110,13 +110,6 @@ struct GptOptions {
   // from (T2M-GPT's slot 0, which holds its text): generation is asked for
   // a view and cannot drift into another one.
   bool condition_on_view = false;
-  // The view token's embedding is also added to every token's input, so
-  // each position sees the view directly rather than only through
-  // attention to slot 0 (which local periodicity lets the prior ignore:
-  // a walk's codes near a view's neighbours led streams to drift through
-  // the neighbouring views and turn the walker around; docs/generation.md
-  // 4b). Needs condition_on_view.
-  bool view_in_every_token = false;
   int batch_size = 64;
   double learning_rate = 2e-4;  // AdamW
   int64_t steps = 20000;
@@ -135,8 +128,6 @@ struct GptOptions {
       "input tokens kept (others replaced by random codes)");
     v("condition_on_view", self.condition_on_view, Range::Any(),
       "windows open with a token naming the data's view");
-    v("view_in_every_token", self.view_in_every_token, Range::Any(),
-      "the view's embedding is added to every input token too");
     v("batch_size", self.batch_size, Range::Closed(1, 100000),
       "token windows per gradient step");
     v("learning_rate", self.learning_rate, Range::Above(0), "AdamW rate");

@@ -119,8 +119,6 @@ torch::Tensor GptImpl::forward(const torch::Tensor& tokens) {
               " tokens exceeds the context of ", options_.context_tokens);
   torch::Tensor x = token_embedding_->forward(tokens) +
                     position_embedding_.narrow(0, 0, length).unsqueeze(0);
-  if (options_.view_in_every_token)  // slot 0: the window's view token
-    x = x + token_embedding_->forward(tokens.select(1, 0)).unsqueeze(1);
   x = dropout_->forward(x).transpose(0, 1);  // [S, B, E]
   torch::Tensor mask =
       torch::full({length, length}, -std::numeric_limits<float>::infinity())
@@ -141,11 +139,6 @@ torch::Tensor GptImpl::ForwardCached(const torch::Tensor& tokens,
   }
   torch::Tensor x = token_embedding_->forward(tokens) +
                     position_embedding_.narrow(0, cache->length, count);
-  if (options_.view_in_every_token) {
-    if (cache->length == 0)
-      cache->condition = token_embedding_->forward(tokens[0]);
-    x = x + cache->condition;
-  }
   for (size_t b = 0; b < blocks_.size(); ++b)
     x = blocks_[b]->Step(x, &cache->keys[b], &cache->values[b]);
   cache->length += count;

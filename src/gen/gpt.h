@@ -42,9 +42,6 @@ TORCH_MODULE(CausalBlock);
 struct GptCache {
   std::vector<torch::Tensor> keys, values;
   int64_t length = 0;
-  // With view_in_every_token: the embedding of the first token fed (the
-  // view token) added to every later one's input; undefined otherwise.
-  torch::Tensor condition;
 };
 
 class GptImpl : public torch::nn::Module {
@@ -55,16 +52,12 @@ class GptImpl : public torch::nn::Module {
   GptImpl(int num_codes, const GptOptions& options, int num_views = 0);
 
   // tokens: [B, S] int64 in [0, K], S <= context_tokens -> logits over the
-  // K codes [B, S, K] for each next token. With view_in_every_token, slot 0
-  // of every window is its view token, and its embedding is added to every
-  // slot's input.
+  // K codes [B, S, K] for each next token.
   torch::Tensor forward(const torch::Tensor& tokens);
 
   // Inference: appends `tokens` (a 1-D int64 tensor, at most the context
-  // left in `cache`; the first fed to an empty cache opens the window, the
-  // view token for a conditioned prior) to the cached sequence and returns the
-  // logits [K] for the token after them. Matches forward() on the cached
-  // sequence.
+  // left in `cache`) to the cached sequence and returns the logits [K] for
+  // the token after them. Matches forward() on the cached sequence.
   torch::Tensor ForwardCached(const torch::Tensor& tokens, GptCache* cache);
 
   int num_codes() const { return num_codes_; }

@@ -18,20 +18,6 @@ GptOptions SmallGpt() {
   return options;
 }
 
-// Feeds `tokens` to ForwardCached, a prefix of `prefix` tokens at once and
-// then token by token: every step's logits must equal the full forward's
-// at that position.
-void ExpectCachedAsFull(Gpt& gpt, const torch::Tensor& tokens, int64_t prefix,
-                        GptCache* cache) {
-  const torch::Tensor full = gpt->forward(tokens.unsqueeze(0))[0];  // [S, K]
-  torch::Tensor logits = gpt->ForwardCached(tokens.narrow(0, 0, prefix), cache);
-  EXPECT_TRUE(torch::allclose(logits, full[prefix - 1], 1e-5, 1e-5));
-  for (int64_t s = prefix; s < tokens.size(0); ++s) {
-    logits = gpt->ForwardCached(tokens.narrow(0, s, 1), cache);
-    EXPECT_TRUE(torch::allclose(logits, full[s], 1e-5, 1e-5)) << "at " << s;
-  }
-}
-
 TEST(Gpt, IsCausal) {
   // Changing a later token never changes an earlier position's logits.
   torch::manual_seed(1);
@@ -55,38 +41,17 @@ TEST(Gpt, CachedInferenceMatchesTheFullForward) {
   torch::NoGradGuard no_grad;
   const torch::Tensor tokens =
       torch::tensor({16, 3, 5, 7, 9, 11, 2, 2, 14, 0, 1, 6}, torch::kLong);
+  const torch::Tensor full = gpt->forward(tokens.unsqueeze(0))[0];  // [S, K]
   GptCache cache;
-  ExpectCachedAsFull(gpt, tokens, 4, &cache);
+  torch::Tensor logits = gpt->ForwardCached(tokens.narrow(0, 0, 4), &cache);
+  EXPECT_TRUE(torch::allclose(logits, full[3], 1e-5, 1e-5));
+  for (int64_t s = 4; s < tokens.size(0); ++s) {
+    logits = gpt->ForwardCached(tokens.narrow(0, s, 1), &cache);
+    EXPECT_TRUE(torch::allclose(logits, full[s], 1e-5, 1e-5)) << "at " << s;
+  }
   EXPECT_EQ(cache.length, 12);
   // The context is full: one more token is refused.
   EXPECT_THROW(gpt->ForwardCached(tokens.narrow(0, 0, 1), &cache), c10::Error);
-}
-
-TEST(Gpt, AViewInEveryTokenIsCachedAsTheFullForwardSeesIt) {
-  // With view_in_every_token the window's first token (its view) is added
-  // to every input: incremental inference keeps it across steps, and a
-  // different view changes every position's logits, not only through
-  // attention.
-  torch::manual_seed(3);
-  GptOptions options = SmallGpt();
-  options.condition_on_view = true;
-  options.view_in_every_token = true;
-  options.Validate();
-  Gpt gpt(16, options, /*num_views=*/2);
-  gpt->eval();
-  torch::NoGradGuard no_grad;
-  const torch::Tensor tokens = torch::tensor(std::vector<int64_t>{
-      gpt->view_token(1), 16, 3, 5, 7, 9, 11, 2, 2, 14, 0, 1});
-  GptCache cache;
-  ExpectCachedAsFull(gpt, tokens, 3, &cache);
-  const torch::Tensor full = gpt->forward(tokens.unsqueeze(0))[0];
-  torch::Tensor other = tokens.clone();
-  other[0] = gpt->view_token(0);
-  const torch::Tensor other_full = gpt->forward(other.unsqueeze(0))[0];
-  EXPECT_FALSE(torch::allclose(other_full[1], full[1], 1e-3, 1e-3));
-  // The option without a view to add is refused.
-  options.condition_on_view = false;
-  EXPECT_THROW(options.Validate(), ConfigError);
 }
 
 TEST(Gpt, SamplingIsDeterministicForASeed) {
