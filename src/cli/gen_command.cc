@@ -56,7 +56,7 @@ GenDataset LoadGenDataset(const GenConfig& config,
                        std::move(loaded.keypoint_map)});
   }
   return BuildGenDataset(sources, config.data.views, config.data.fps,
-                         config.data.loop_to_s);
+                         config.data.loop_to_s, config.data.loop_heading);
 }
 
 int RunGenTrain(const GenTrainArgs& args) {

@@ -74,6 +74,17 @@ void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
       ->capture_default_str();
   command.add_option("--height", rig.height_px, "Image height (px)")
       ->capture_default_str();
+  command
+      .add_option("--loop-heading", options->loop_heading,
+                  "A looping motion repeated to --duration: accumulate (each "
+                  "cycle turns by the cycle's net heading turn once more, as "
+                  "DeepMimic wraps it) or straight (the turn spread back over "
+                  "the cycle: a straight path)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, LoopHeading>{
+              {"accumulate", LoopHeading::kAccumulate},
+              {"straight", LoopHeading::kStraight}},
+          CLI::ignore_case));
   command.add_flag("--follow", *follow,
                    "Cameras dolly along with the subject's ground path");
   command

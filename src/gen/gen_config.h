@@ -23,6 +23,11 @@ struct GenDataOptions {
   // A looping motion (DeepMimic's walk cycle) is repeated to at least this
   // long, so that the prior sees cycles follow each other.
   double loop_to_s = 20.0;
+  // What the cycle's net heading turn does across the repeats: the
+  // DeepMimic walk turns about 100 deg in 20 s when it accumulates; a
+  // prior over 4-s windows cannot tell how far a sequence has turned, so
+  // its generations turn back and forth and jump between headings.
+  LoopHeading loop_heading = LoopHeading::kAccumulate;
   GenViewOptions views;
 
   template <typename Self, typename Visitor>
@@ -32,6 +37,9 @@ struct GenDataOptions {
     v("fps", self.fps, Range::Closed(1, 240), "frame rate of the 2D (Hz)");
     v("loop_to_s", self.loop_to_s, Range::Closed(0, 3600),
       "looping motions are repeated to at least this long (s)");
+    v("loop_heading", self.loop_heading, Range::Any(),
+      "a cycle's net heading turn across the repeats: accumulate (DeepMimic's "
+      "wrap) or straight (spread back over the cycle)");
     v("num_azimuths", self.views.num_azimuths, Range::Closed(1, 360),
       "views per elevation, spread over 360 degrees");
     v("elevations_deg", self.views.elevations_deg, Range::Open(-80, 80),

@@ -282,7 +282,7 @@ void FeatureStatistics(const std::vector<GenSequence>& sequences,
 
 GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
                            const GenViewOptions& views, double fps,
-                           double loop_to_s) {
+                           double loop_to_s, LoopHeading loop_heading) {
   views.Validate();
   GenDataset dataset;
   dataset.fps = fps;
@@ -295,6 +295,7 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
       options.fps = fps;
       if (source.motion.loops)
         options.duration_s = std::max(source.motion.duration_s(), loop_to_s);
+      options.loop_heading = loop_heading;
       options.follow = CameraFollow::kRootDolly;
       options.follow_smoothing_s = views.follow_smoothing_s;
       options.rig.num_views = views.num_azimuths;

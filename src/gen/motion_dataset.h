@@ -102,12 +102,13 @@ inline constexpr float kMinFeatureStd = 1e-3f;
 
 // Projects every motion into every view (motion/bundle.h's
 // MakeBundleFromMotion at `fps`; a looping motion repeated to at least
-// `loop_to_s`) and stores each view's canonical features; then the
-// normalization statistics. Throws InputError naming a motion whose
-// projection has no usable frame.
+// `loop_to_s`, its heading turn per `loop_heading`) and stores each view's
+// canonical features; then the normalization statistics. Throws InputError
+// naming a motion whose projection has no usable frame.
 GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
                            const GenViewOptions& views, double fps,
-                           double loop_to_s);
+                           double loop_to_s,
+                           LoopHeading loop_heading = LoopHeading::kAccumulate);
 
 // `sequence` cut in time into `num_parts` consecutive parts of equal
 // length (the last ones a frame longer when it does not divide), named

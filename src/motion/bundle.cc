@@ -483,7 +483,8 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
   // per view (moving the camera with the subject when following), add detector
   // noise.
   options.Validate();
-  Motion3D sampled = ExtendLoop(motion, options.duration_s);
+  Motion3D sampled =
+      ExtendLoop(motion, options.duration_s, options.loop_heading);
   sampled = ResampleMotion(sampled, options.fps);
   if (options.duration_s > 0) {
     int wanted =

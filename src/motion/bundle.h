@@ -139,7 +139,8 @@ enum class RigAim {
 struct BundleFromMotionOptions {
   double fps = 30.0;        // frame rate of the 2D clips
   double duration_s = 0.0;  // > motion length: loop a looping motion
-  RigOptions rig;           // rig.target_m is relative to `aim`
+  LoopHeading loop_heading = LoopHeading::kAccumulate;  // across the loops
+  RigOptions rig;  // rig.target_m is relative to `aim`
   RigAim aim = RigAim::kStartRoot;
   CameraFollow follow = CameraFollow::kStatic;
   double follow_smoothing_s = 1.0;  // window of the dolly's moving average

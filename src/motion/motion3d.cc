@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/settings.h"
+
 namespace m2d {
 
 void ForwardKinematics(const Skeleton& skeleton, const Pose3D& pose,
@@ -118,7 +120,17 @@ Motion3D CloseLoopSeam(const Motion3D& motion,
 
 }  // namespace
 
-Motion3D ExtendLoop(const Motion3D& looping_motion, double duration_s) {
+const char* SettingName(LoopHeading heading) {
+  return heading == LoopHeading::kStraight ? "straight" : "accumulate";
+}
+
+bool ParseSetting(const std::string& text, LoopHeading* heading) {
+  return ParseSettingByName(
+      text, {LoopHeading::kAccumulate, LoopHeading::kStraight}, heading);
+}
+
+Motion3D ExtendLoop(const Motion3D& looping_motion, double duration_s,
+                    LoopHeading heading) {
   if (!looping_motion.loops || looping_motion.num_frames() < 2 ||
       looping_motion.duration_s() >= duration_s)
     return looping_motion;
@@ -127,9 +139,29 @@ Motion3D ExtendLoop(const Motion3D& looping_motion, double duration_s) {
   // frame 0 to frame n-1; each repetition applies it once more.
   double turn = HeadingAngle(looping_motion.frames.back().local_rotations[0]) -
                 HeadingAngle(looping_motion.frames.front().local_rotations[0]);
+  turn = std::remainder(turn, 2.0 * M_PI);
+  Motion3D cycle = looping_motion;
+  if (heading == LoopHeading::kStraight) {
+    // Frame i turns back by the share i / (n-1) of the turn, about the first
+    // frame's root: the root's orientation and its horizontal path alike.
+    const Eigen::Vector3d anchor = cycle.frames.front().root_position_m;
+    const int n = cycle.num_frames();
+    for (int i = 1; i < n; ++i) {
+      const Eigen::Quaterniond back(
+          Eigen::AngleAxisd(-turn * i / (n - 1.0), Eigen::Vector3d::UnitZ()));
+      Pose3D& pose = cycle.frames[i];
+      Eigen::Vector3d relative = pose.root_position_m - anchor;
+      const double height_m = pose.root_position_m.z();
+      relative.z() = 0.0;
+      pose.root_position_m = anchor + back * relative;
+      pose.root_position_m.z() = height_m;
+      pose.local_rotations[0] = (back * pose.local_rotations[0]).normalized();
+    }
+    turn = 0.0;
+  }
   Eigen::Quaterniond cycle_turn(
       Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()));
-  const Motion3D motion = CloseLoopSeam(looping_motion, cycle_turn);
+  const Motion3D motion = CloseLoopSeam(cycle, cycle_turn);
   const Pose3D& first = motion.frames.front();
   const Pose3D& last = motion.frames.back();
 

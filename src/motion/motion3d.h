@@ -54,11 +54,25 @@ Pose3D SamplePose(const Motion3D& motion, double time_s);
 // The motion resampled at `fps`, covering the same span.
 Motion3D ResampleMotion(const Motion3D& motion, double fps);
 
+// What a looped cycle's net heading turn does across cycles.
+enum class LoopHeading {
+  kAccumulate,  // each cycle turns by it once more (DeepMimic "wrap"): the
+                // DeepMimic walk turns about 6 deg per cycle, 100 deg in 20 s
+  kStraight,    // it is spread back over the cycle: the cycles chain into a
+                // straight path, the heading the first frame's
+};
+const char* SettingName(LoopHeading heading);  // "accumulate", "straight"
+bool ParseSetting(const std::string& text, LoopHeading* heading);
+inline std::string SettingChoices(LoopHeading) {
+  return "accumulate, straight";
+}
+
 // A looping motion repeated until it lasts at least `duration_s`: each new
 // cycle continues from where the previous one ended, with the root's
-// horizontal translation and heading accumulated (DeepMimic "wrap").
-// A non-looping motion is returned unchanged.
-Motion3D ExtendLoop(const Motion3D& motion, double duration_s);
+// horizontal translation and (per `heading`) heading accumulated. A
+// non-looping motion is returned unchanged.
+Motion3D ExtendLoop(const Motion3D& motion, double duration_s,
+                    LoopHeading heading = LoopHeading::kAccumulate);
 
 // Heading (yaw about +z, radians) of an orientation whose local +x is the
 // character's forward direction.

@@ -210,6 +210,49 @@ TEST(GenDataset, ADollyOnTheRootKeepsTheImageRootInPlace) {
   EXPECT_THROW(views.Validate(), ConfigError);
 }
 
+// The walker's facing in the image: the left shoulder's local x minus the
+// right's (body scales), averaged over `frames` from `first`.
+double MeanShoulderWidth(const GenSequence& sequence, int frame_size, int first,
+                         int frames) {
+  const int left = Coco17Layout().IndexOf("left_shoulder");
+  const int right = Coco17Layout().IndexOf("right_shoulder");
+  double sum = 0.0;
+  for (int t = first; t < first + frames; ++t) {
+    const float* row =
+        sequence.features.data() + static_cast<size_t>(t) * frame_size;
+    sum += row[2 * left] - row[2 * right];
+  }
+  return sum / frames;
+}
+
+// Under a following camera at a fixed azimuth, the wrapped walk turns in
+// the image over 20 s (it goes round a wide circle); straightened, it is
+// seen from the same side throughout.
+TEST(GenDataset, AStraightLoopKeepsItsFacing) {
+  GenViewOptions views;
+  views.num_azimuths = 4;
+  views.elevations_deg = {10};
+  views.follow_smoothing_s = 0.0;
+  const GenDataset wrapped = BuildGenDataset({WalkSource()}, views, 30.0, 20.0);
+  const GenDataset straight = BuildGenDataset({WalkSource()}, views, 30.0, 20.0,
+                                              LoopHeading::kStraight);
+  double turned_least = 1e9, straight_most = 0.0;
+  for (size_t i = 0; i < wrapped.sequences.size(); ++i) {
+    const int size = wrapped.frame_size;
+    const int last = wrapped.sequences[i].num_frames - 60;
+    turned_least = std::min(
+        turned_least,
+        std::abs(MeanShoulderWidth(wrapped.sequences[i], size, last, 60) -
+                 MeanShoulderWidth(wrapped.sequences[i], size, 0, 60)));
+    straight_most = std::max(
+        straight_most,
+        std::abs(MeanShoulderWidth(straight.sequences[i], size, last, 60) -
+                 MeanShoulderWidth(straight.sequences[i], size, 0, 60)));
+  }
+  EXPECT_GT(turned_least, 0.2);
+  EXPECT_LT(straight_most, 0.05);
+}
+
 TEST(GenDataset, RejectsViewsThatCannotBe) {
   GenViewOptions views;
   views.elevations_deg = {};

@@ -142,6 +142,52 @@ TEST(DeepMimicReader, ExtendLoopClosesTheCycleSeam) {
   }
 }
 
+TEST(DeepMimicReader, AStraightLoopWalksAStraightLine) {
+  // The walk cycle turns its heading a little each cycle; accumulated over
+  // 20 s the walker goes round a wide circle. Straight, every cycle starts
+  // with the first frame's heading, the path keeps to a line, and neither
+  // the root nor its rotation jumps at a seam.
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  Motion3D motion = ReadDeepMimicMotion(path, Humanoid());
+  const int n = motion.num_frames();
+  auto heading_change_deg = [](const Pose3D& a, const Pose3D& b) {
+    return std::abs(std::remainder(HeadingAngle(b.local_rotations[0]) -
+                                       HeadingAngle(a.local_rotations[0]),
+                                   2 * M_PI)) *
+           180 / M_PI;
+  };
+  const Motion3D wrapped = ExtendLoop(motion, 20.0);
+  EXPECT_GT(heading_change_deg(wrapped.frames.front(), wrapped.frames.back()),
+            45.0);
+  const Motion3D straight = ExtendLoop(motion, 20.0, LoopHeading::kStraight);
+  ASSERT_EQ(straight.num_frames(), wrapped.num_frames());
+  for (int seam = n - 1; seam < straight.num_frames(); seam += n - 1) {
+    EXPECT_LT(
+        heading_change_deg(straight.frames.front(), straight.frames[seam]), 1.0)
+        << "cycle starting at frame " << seam;
+  }
+  // Lateral distance of the root from the line through its ends.
+  const Eigen::Vector3d start = straight.frames.front().root_position_m;
+  Eigen::Vector3d line = straight.frames.back().root_position_m - start;
+  line.z() = 0.0;
+  EXPECT_GT(line.norm(), 15.0);  // about 20 s of walking
+  line.normalize();
+  double widest_m = 0.0;
+  for (const Pose3D& pose : straight.frames) {
+    Eigen::Vector3d offset = pose.root_position_m - start;
+    offset.z() = 0.0;
+    widest_m = std::max(widest_m, (offset - offset.dot(line) * line).norm());
+  }
+  EXPECT_LT(widest_m, 0.2);
+  const double root_turn_step = MaxJointStep(motion, 0, 1, n);
+  for (int seam = n - 1; seam + 1 < straight.num_frames(); seam += n - 1)
+    EXPECT_LT(MaxJointStep(straight, 0, seam, seam + 2), root_turn_step + 0.03);
+  LoopHeading parsed = LoopHeading::kAccumulate;
+  EXPECT_TRUE(ParseSetting("straight", &parsed));
+  EXPECT_EQ(parsed, LoopHeading::kStraight);
+  EXPECT_FALSE(ParseSetting("circle", &parsed));
+}
+
 TEST(DeepMimicReader, ResampleKeepsSpanAndEndpoints) {
   M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
   Motion3D motion = ReadDeepMimicMotion(path, Humanoid());
