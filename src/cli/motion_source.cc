@@ -82,8 +82,8 @@ void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
                   "the cycle: a straight path)")
       ->transform(CLI::CheckedTransformer(
           std::map<std::string, LoopHeading>{
-              {"accumulate", LoopHeading::kAccumulate},
-              {"straight", LoopHeading::kStraight}},
+              {SettingName(LoopHeading::kAccumulate), LoopHeading::kAccumulate},
+              {SettingName(LoopHeading::kStraight), LoopHeading::kStraight}},
           CLI::ignore_case));
   command.add_flag("--follow", *follow,
                    "Cameras dolly along with the subject's ground path");
