@@ -4,7 +4,7 @@
 # cameras following the root), stripped to their 2D and fitted view by view
 # with the focal known: the data of a walk tracker that covers every view
 # the generator generates (the walk2d tracker knows elevation 10 deg only;
-# docs/generation.md 4b). About 2.5 min of fitting per view on 2 threads.
+# docs/generation.md 4b). About a minute of fitting per view on one thread (41 s on 2).
 #
 #   [FIT_THREADS=N] scripts/make_walk24.sh [OUT_DIR]   (default runs/walk24)
 #
