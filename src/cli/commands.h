@@ -18,6 +18,8 @@ void AddRenderCommand(CLI::App& app, CommandRun* run);
 void AddPlotCommand(CLI::App& app, CommandRun* run);
 void AddReportCommand(CLI::App& app, CommandRun* run);
 void AddTrainCommand(CLI::App& app, CommandRun* run);
+// `checkpoint slim`.
+void AddCheckpointCommand(CLI::App& app, CommandRun* run);
 void AddEvalCommand(CLI::App& app, CommandRun* run);
 void AddFitCommand(CLI::App& app, CommandRun* run);
 void AddPriorCommand(CLI::App& app, CommandRun* run);

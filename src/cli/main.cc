@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   m2d::cli::AddPlotCommand(app, &run);
   m2d::cli::AddReportCommand(app, &run);
   m2d::cli::AddTrainCommand(app, &run);
+  m2d::cli::AddCheckpointCommand(app, &run);
   m2d::cli::AddEvalCommand(app, &run);
   m2d::cli::AddFitCommand(app, &run);
   m2d::cli::AddPriorCommand(app, &run);

@@ -390,4 +390,25 @@ void LoadCheckpointStateBuffers(const std::string& path,
   });
 }
 
+SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
+                                          const std::string& out) {
+  // Build the networks and optimizer the checkpoint's own config describes,
+  // load everything but the buffers, and save with none.
+  const TrainConfig config = ReadCheckpointConfig(in);
+  int action_size = 0;
+  const ObservationLayout layout = ReadCheckpointLayout(in, &action_size);
+  ActorCritic model(layout, config.model, action_size);
+  torch::optim::Adam optimizer(
+      model->parameters(), torch::optim::AdamOptions(config.ppo.learning_rate));
+  const CheckpointCounters counters = LoadCheckpoint(
+      in, model, &optimizer, /*initial_states=*/nullptr, SimState());
+  SlimCheckpointSummary summary;
+  summary.bytes_before = static_cast<int64_t>(std::filesystem::file_size(in));
+  summary.samples = counters.samples;
+  SaveCheckpoint(out, config, model, optimizer, counters,
+                 /*initial_states=*/nullptr, SimState());
+  summary.bytes_after = static_cast<int64_t>(std::filesystem::file_size(out));
+  return summary;
+}
+
 }  // namespace m2d

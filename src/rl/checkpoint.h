@@ -53,6 +53,23 @@ void LoadCheckpointStateBuffers(const std::string& path,
                                 InitialStates* initial_states,
                                 const SimState& state_template);
 
+// What WriteSlimCheckpoint kept.
+struct SlimCheckpointSummary {
+  int64_t bytes_before = 0;
+  int64_t bytes_after = 0;
+  int64_t samples = 0;  // the run's counters, unchanged
+};
+
+// Writes `in` without its ASI state buffers to `out` (atomically; `out` may
+// be `in`): the networks, optimizer, counters and config, which is all that
+// evaluation, `generate --policy` and `run.init_from` read. A run resumed
+// from it refills its buffers from the reference, as a fresh run does.
+// Buffers grow with views x frames (133 MB for 24 views of 20 s), too big to
+// commit or carry a policy with. InputError naming the file when `in` is
+// not a mimic2d checkpoint.
+SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
+                                          const std::string& out);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_RL_CHECKPOINT_H_

@@ -445,5 +445,88 @@ TEST(Checkpoint, InitialStateBuffersOfAnotherTaskAreRejected) {
   fs::remove_all(dir);
 }
 
+// `checkpoint slim`: the buffers go, everything a policy or a resumed run
+// reads stays, bit for bit.
+TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffers) {
+  const std::string dir = testing::TempDir("checkpoint_slim");
+  const std::string path = dir + "/checkpoint.pt";
+  const std::string slim_path = dir + "/slim.pt";
+  TrackingTaskOptions options;
+  auto character = testing::LoadHumanoid(options.simulation);
+  ReferenceBundle bundle = testing::MakeGlidingBundle(*character, 0.5);
+  TrackingTask task = BuildTrackingTask(character, {bundle}, options);
+  const SimState state_template =
+      Simulation(character, options.simulation).Save();
+  StateBuffer& buffer = task.initial_states->buffer(0);
+  const int fresh_size = buffer.size(3);
+  for (int k = 0; k < buffer.options().capacity_per_frame; ++k) {
+    SimState state = buffer.entry(3, 0).state;
+    state.qpos[0] += 0.01 * (k + 1);
+    buffer.Insert(3, state, 2.0 + k);
+  }
+  ASSERT_GT(buffer.size(3), fresh_size);
+  TrainConfig config;
+  config.data.bundles = {"walk.json"};  // read back, so it must validate
+  config.ppo.num_envs = 24;
+  config.model = TinyModel();
+  TrainedModel saved = MakeTrainedModel(SmallLayout(), kActions, 1);
+  for (auto& group : saved.optimizer->param_groups())
+    group.options().set_lr(1.75e-5);
+  CheckpointCounters counters;
+  counters.iteration = 12;
+  counters.samples = 4242;
+  SaveCheckpoint(path, config, saved.model, *saved.optimizer, counters,
+                 task.initial_states.get(), state_template);
+
+  const SlimCheckpointSummary summary = WriteSlimCheckpoint(path, slim_path);
+  EXPECT_EQ(summary.samples, 4242);
+  EXPECT_EQ(summary.bytes_before, static_cast<int64_t>(fs::file_size(path)));
+  EXPECT_EQ(summary.bytes_after,
+            static_cast<int64_t>(fs::file_size(slim_path)));
+  EXPECT_LT(summary.bytes_after, summary.bytes_before);
+
+  // Networks, normalizer, Adam's moments and rate, counters: as saved.
+  TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 2);
+  InitialStates fresh(*task.reference, character, options.simulation,
+                      StateBufferOptions());
+  const CheckpointCounters read = LoadCheckpoint(
+      slim_path, loaded.model, loaded.optimizer.get(), &fresh, state_template);
+  EXPECT_EQ(read.iteration, 12);
+  EXPECT_EQ(read.samples, 4242);
+  EXPECT_EQ(read.learning_rate, 1.75e-5);
+  EXPECT_TRUE(SameTensors(loaded.model->named_parameters(),
+                          saved.model->named_parameters()));
+  EXPECT_TRUE(
+      SameTensors(loaded.model->named_buffers(), saved.model->named_buffers()));
+  // Adam's moments too: the next update is the one the saved run makes.
+  torch::manual_seed(3);
+  torch::Tensor raw = torch::randn({16, SmallLayout().size()});
+  for (TrainedModel* model : {&saved, &loaded}) {
+    model->optimizer->zero_grad();
+    Loss(model->model, raw).backward();
+    model->optimizer->step();
+  }
+  EXPECT_TRUE(SameTensors(loaded.model->named_parameters(),
+                          saved.model->named_parameters()));
+  // No buffers: a resumed run keeps the task's fresh ones; asking for the
+  // buffers alone is an error naming the file.
+  EXPECT_EQ(fresh.buffer(0).size(3), fresh_size);
+  try {
+    LoadCheckpointStateBuffers(slim_path, &fresh, state_template);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(slim_path), std::string::npos) << message;
+    EXPECT_NE(message.find("holds no initial-state buffers"), std::string::npos)
+        << message;
+  }
+  // Not a checkpoint: an error naming the file, nothing written.
+  const std::string text_path = dir + "/notes.txt";
+  std::ofstream(text_path) << "not a checkpoint\n";
+  EXPECT_THROW(WriteSlimCheckpoint(text_path, dir + "/out.pt"), InputError);
+  EXPECT_FALSE(fs::exists(dir + "/out.pt"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace m2d
