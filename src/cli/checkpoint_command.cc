@@ -29,7 +29,7 @@ int RunSlim(const SlimArgs& args) {
 
 void AddCheckpointCommand(CLI::App& app, CommandRun* run) {
   CLI::App* checkpoint = app.add_subcommand(
-      "checkpoint", "Inspect and convert training checkpoints");
+      "checkpoint", "Convert training checkpoints (slim: without ASI buffers)");
   checkpoint->require_subcommand(1);
   auto args = std::make_shared<SlimArgs>();
   CLI::App* slim = checkpoint->add_subcommand(
