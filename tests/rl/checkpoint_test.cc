@@ -90,6 +90,21 @@ bool SameTensors(const torch::OrderedDict<std::string, torch::Tensor>& a,
   return true;
 }
 
+// One Adam step of both on the same batch; true when their weights then
+// agree, i.e. weights, normalizer and Adam's moments were all the same.
+bool TheNextUpdateIsTheSame(const ObservationLayout& layout,
+                            TrainedModel& saved, TrainedModel& loaded) {
+  torch::manual_seed(3);
+  torch::Tensor raw = torch::randn({16, layout.size()});
+  for (TrainedModel* model : {&saved, &loaded}) {
+    model->optimizer->zero_grad();
+    Loss(model->model, raw).backward();
+    model->optimizer->step();
+  }
+  return SameTensors(saved.model->named_parameters(),
+                     loaded.model->named_parameters());
+}
+
 // LibTorch keys optimizer state by the parameter's TensorImpl address.
 const torch::optim::AdamParamState* AdamState(
     const torch::optim::Adam& optimizer, const torch::Tensor& parameter) {
@@ -161,15 +176,7 @@ TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   EXPECT_EQ(with_state, static_cast<int>(saved_parameters.size()) - 1);
 
   // So the next update is the one the saved run would have made.
-  torch::manual_seed(3);
-  torch::Tensor raw = torch::randn({16, layout.size()});
-  for (TrainedModel* model : {&saved, &loaded}) {
-    model->optimizer->zero_grad();
-    Loss(model->model, raw).backward();
-    model->optimizer->step();
-  }
-  EXPECT_TRUE(SameTensors(saved.model->named_parameters(),
-                          loaded.model->named_parameters()));
+  EXPECT_TRUE(TheNextUpdateIsTheSame(layout, saved, loaded));
 
   // The embedded config and layout rebuild the networks.
   EXPECT_EQ(ReadCheckpointConfig(path).ppo.num_envs, 24);
@@ -499,15 +506,7 @@ TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffers) {
   EXPECT_TRUE(
       SameTensors(loaded.model->named_buffers(), saved.model->named_buffers()));
   // Adam's moments too: the next update is the one the saved run makes.
-  torch::manual_seed(3);
-  torch::Tensor raw = torch::randn({16, SmallLayout().size()});
-  for (TrainedModel* model : {&saved, &loaded}) {
-    model->optimizer->zero_grad();
-    Loss(model->model, raw).backward();
-    model->optimizer->step();
-  }
-  EXPECT_TRUE(SameTensors(loaded.model->named_parameters(),
-                          saved.model->named_parameters()));
+  EXPECT_TRUE(TheNextUpdateIsTheSame(SmallLayout(), saved, loaded));
   // No buffers: a resumed run keeps the task's fresh ones; asking for the
   // buffers alone is an error naming the file.
   EXPECT_EQ(fresh.buffer(0).size(3), fresh_size);
