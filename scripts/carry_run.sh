@@ -10,6 +10,9 @@
 # Only what --resume needs travels: checkpoint.pt (networks, optimizer,
 # normalizer, ASI buffers, counters), train_log.csv and config.yaml. The
 # bundles the config names are rebuilt by their own script (deterministic).
+# A checkpoint too big to commit goes slim first (`build/mimic2d checkpoint
+# slim runs/NAME/checkpoint.pt -o runs/NAME/checkpoint.pt`): without the
+# ASI buffers, which the resumed run refills from its bundles.
 # restore refuses to replace a run that has trained further.
 set -euo pipefail
 cd "$(dirname "$0")/.."
