@@ -416,4 +416,38 @@ SimState PlacedDefaultState(std::shared_ptr<const Character> character,
   return simulation.Save();
 }
 
+void InitialStates::SetViewWeights(const std::vector<double>& weights) {
+  if (static_cast<int>(weights.size()) != num_views()) {
+    throw ConfigError("initial states: " + std::to_string(weights.size()) +
+                      " view weights for " + std::to_string(num_views()) +
+                      " views");
+  }
+  std::vector<double> cumulative;
+  double total = 0.0;
+  for (double weight : weights) {
+    if (!std::isfinite(weight) || weight < 0.0) {
+      throw ConfigError("initial states: a view weight is " +
+                        std::to_string(weight) + " (finite, >= 0 expected)");
+    }
+    total += weight;
+    cumulative.push_back(total);
+  }
+  if (total <= 0.0) {
+    throw ConfigError("initial states: every view weight is 0");
+  }
+  view_cumulative_weights_ = std::move(cumulative);
+}
+
+int InitialStates::DrawView(std::mt19937_64& rng) const {
+  if (view_cumulative_weights_.empty()) {
+    return std::uniform_int_distribution<int>(0, num_views() - 1)(rng);
+  }
+  const double u = std::uniform_real_distribution<double>(
+      0.0, view_cumulative_weights_.back())(rng);
+  const auto it = std::upper_bound(view_cumulative_weights_.begin(),
+                                   view_cumulative_weights_.end(), u);
+  return std::min(static_cast<int>(it - view_cumulative_weights_.begin()),
+                  num_views() - 1);
+}
+
 }  // namespace m2d

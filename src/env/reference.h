@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -138,6 +139,13 @@ class InitialStates {
   const std::vector<BodyTarget3D>& motion(int index) const {
     return motions_[index];
   }
+  // Which view an episode starts on (TrackingEnv::Reset): uniformly until
+  // weights are set, then in proportion to them (hard-view sampling,
+  // rl/hard_views.h). Set between rollouts, as the buffers are.
+  // ConfigError unless one finite weight >= 0 per view, not all zero.
+  void SetViewWeights(const std::vector<double>& weights);
+  int DrawView(std::mt19937_64& rng) const;
+  int num_views() const { return static_cast<int>(buffer_of_view_.size()); }
   // ReferenceFingerprint of the reference the buffers were filled for: a
   // checkpoint's buffers are restored only into the same reference.
   uint64_t reference_fingerprint() const { return reference_fingerprint_; }
@@ -147,6 +155,8 @@ class InitialStates {
   std::vector<StateBuffer> buffers_;
   std::vector<std::vector<BodyTarget3D>> motions_;
   std::vector<int> buffer_of_view_;
+  // Running sums of the view weights; empty: uniform.
+  std::vector<double> view_cumulative_weights_;
 };
 
 }  // namespace m2d

@@ -71,12 +71,11 @@ void TrackingEnv::Rebase(std::shared_ptr<const TrackingReference> reference) {
 }
 
 void TrackingEnv::Reset(float* observation) {
-  // Outline: pick a view uniformly, a start frame uniformly (leaving at
-  // least one step), an initial state from that frame's buffer.
-  const std::vector<TrackedView>& views = reference_->views();
-  int view_index = std::uniform_int_distribution<int>(
-      0, static_cast<int>(views.size()) - 1)(rng_);
-  const TrackedView& view = views[view_index];
+  // Outline: pick a view (uniformly, or as hard-view sampling weighs them),
+  // a start frame uniformly (leaving at least one step), an initial state
+  // from that frame's buffer.
+  const int view_index = initial_states_->DrawView(rng_);
+  const TrackedView& view = reference_->views()[view_index];
   int frame = std::uniform_int_distribution<int>(0, view.num_frames - 2)(rng_);
   const StateBuffer& buffer = initial_states_->BufferOfView(view_index);
   ResetTo(view_index, frame, buffer.Draw(frame, rng_), observation);

@@ -212,6 +212,12 @@ struct AsiOptions {
   // moves; an entry's stored score ages).
   int rescore_every_iterations = 10;
   StateBufferOptions buffer{4, 2.0};  // per frame: 4 states, T = 2 (of V)
+  // Hard-view sampling (rl/hard_views.h): the share of episode starts drawn
+  // in proportion to each view's estimated chance that a rollout of the
+  // whole view fails; 0: every view alike. Independent of `enabled`.
+  double hard_view_share = 0.0;
+  // The failure records forget with this half life (samples of training).
+  double hard_view_half_life_samples = 2e6;
 
   // Every setting (common/settings.h): the config's `asi` section.
   template <typename Self, typename Visitor>
@@ -225,6 +231,13 @@ struct AsiOptions {
       "every kept entry is rescored by the critic every this many "
       "iterations");
     decltype(self.buffer)::VisitFields(self.buffer, v);
+    v("hard_view_share", self.hard_view_share, Range::Closed(0, 1),
+      "share of episode starts drawn in proportion to each view's estimated "
+      "chance of failing a whole rollout (hard-view sampling); 0: uniform "
+      "over views");
+    v("hard_view_half_life_samples", self.hard_view_half_life_samples,
+      Range::Above(0),
+      "half life (samples) of the failure records hard-view sampling reads");
   }
   void Validate() const;
 };

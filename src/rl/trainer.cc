@@ -19,6 +19,7 @@
 #include "rl/asi_updater.h"
 #include "rl/checkpoint.h"
 #include "rl/collector.h"
+#include "rl/hard_views.h"
 #include "rl/ppo.h"
 #include "rl/thread_tuner.h"
 
@@ -46,7 +47,8 @@ struct Trainer::State {
   std::shared_ptr<const TrackingReference> reference;
   std::shared_ptr<InitialStates> initial_states;
   std::unique_ptr<VecEnv> envs;
-  std::unique_ptr<AsiUpdater> asi;  // with asi.enabled
+  std::unique_ptr<AsiUpdater> asi;              // with asi.enabled
+  std::unique_ptr<HardViewSampler> hard_views;  // with asi.hard_view_share
   ActorCritic model{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer;
   torch::Generator generator;
@@ -161,6 +163,13 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     s.asi = std::make_unique<AsiUpdater>(s.character, s.reference,
                                          s.initial_states, config.env,
                                          config.asi, run.seed, run.env_threads);
+  }
+  if (config.asi.hard_view_share > 0.0) {
+    // The records start empty (also on resume: they are not checkpointed);
+    // starts stay uniform until episodes have ended.
+    s.hard_views = std::make_unique<HardViewSampler>(
+        *s.reference, config.asi.hard_view_share,
+        config.asi.hard_view_half_life_samples);
   }
   s.state_template = s.envs->env(0).simulation().Save();
   s.model = ActorCritic(s.envs->layout(), config.model, s.envs->action_size());
@@ -402,6 +411,11 @@ TrainSummary Trainer::Run(
           [&](const torch::Tensor& raw) { return s.CriticValue(raw); },
           s.counters.iteration);
     }
+    // 3b. Where episodes start: views weighed by their failures.
+    if (s.hard_views) {
+      s.hard_views->Record(step.finished, config.ppo.batch_size());
+      s.initial_states->SetViewWeights(s.hard_views->Weights());
+    }
     // 4. Report.
     IterationTiming timing{SecondsSince(start), step.collect_s, step.update_s,
                            SecondsSince(asi_start)};
@@ -417,6 +431,9 @@ TrainSummary Trainer::Run(
     // 5. Checkpoint every few minutes.
     if (SecondsSince(last_checkpoint) > 60.0 * config.run.checkpoint_minutes) {
       s.Save();
+      if (s.hard_views) {
+        spdlog::info("hardest views: {}", s.hard_views->Report(5));
+      }
       last_checkpoint = Clock::now();
     }
   }

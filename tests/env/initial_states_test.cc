@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "common/error.h"
 #include "env/reference.h"
@@ -224,6 +226,48 @@ TEST(InitialStates, AnEstimatedStateIsTheBufferFilledFromTheEstimate) {
   EXPECT_THROW(
       EstimatedState(character, options, poses, static_cast<int>(poses.size())),
       ConfigError);
+}
+
+TEST(InitialStates, EpisodesStartOnViewsInProportionToTheirWeights) {
+  SimulationOptions options;
+  auto character = testing::LoadHumanoid(options);
+  std::vector<ReferenceBundle> bundles;
+  bundles.push_back(testing::MakeGlidingBundle(*character, 1.0, 3));
+  TrackingTaskOptions task_options;
+  task_options.simulation = options;
+  TrackingTask task =
+      BuildTrackingTask(character, std::move(bundles), task_options);
+  InitialStates& states = *task.initial_states;
+  ASSERT_EQ(states.num_views(), 3);
+
+  // Uniform until weights are set: the draws of a plain uniform integer.
+  std::mt19937_64 rng(5), same(5);
+  for (int i = 0; i < 100; ++i) {
+    EXPECT_EQ(states.DrawView(rng),
+              std::uniform_int_distribution<int>(0, 2)(same));
+  }
+  // Weighted: in proportion, never a zero-weight view.
+  states.SetViewWeights({0.0, 3.0, 1.0});
+  std::vector<int> counts(3, 0);
+  for (int i = 0; i < 4000; ++i) ++counts[states.DrawView(rng)];
+  EXPECT_EQ(counts[0], 0);
+  EXPECT_NEAR(counts[1] / 4000.0, 0.75, 0.03);
+  EXPECT_NEAR(counts[2] / 4000.0, 0.25, 0.03);
+  // The environments' episodes follow them.
+  states.SetViewWeights({0.0, 0.0, 1.0});
+  TrackingEnv env(character, task.reference, task.initial_states,
+                  TrackingEnvOptions(), /*seed=*/3);
+  std::vector<float> observation(env.observation_size());
+  for (int i = 0; i < 20; ++i) {
+    env.Reset(observation.data());
+    EXPECT_EQ(env.episode().view_index, 2);
+  }
+  // Refused, the weights left as they were.
+  EXPECT_THROW(states.SetViewWeights({1.0, 1.0}), ConfigError);
+  EXPECT_THROW(states.SetViewWeights({1.0, -1.0, 1.0}), ConfigError);
+  EXPECT_THROW(states.SetViewWeights({1.0, NAN, 1.0}), ConfigError);
+  EXPECT_THROW(states.SetViewWeights({0.0, 0.0, 0.0}), ConfigError);
+  EXPECT_EQ(states.DrawView(rng), 2);
 }
 
 }  // namespace

@@ -1,0 +1,102 @@
+#include "rl/hard_views.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "common/error.h"
+
+namespace m2d {
+
+double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
+  if (record.steps <= 0.0) return -1.0;
+  const double hazard_per_step = record.failures / record.steps;
+  return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
+}
+
+std::vector<double> HardViewWeights(
+    const std::vector<ViewFailureRecord>& records,
+    const std::vector<int>& num_frames, double share) {
+  // Outline: each view's failure probability (unknown ones at the known
+  // mean), then the uniform part plus the share in proportion to them.
+  const size_t num_views = records.size();
+  std::vector<double> weights(num_views, 1.0 / num_views);
+  std::vector<double> failure(num_views);
+  double known_sum = 0.0;
+  int known = 0;
+  for (size_t v = 0; v < num_views; ++v) {
+    failure[v] = FullRolloutFailure(records[v], num_frames[v]);
+    if (failure[v] >= 0.0) {
+      known_sum += failure[v];
+      ++known;
+    }
+  }
+  if (known == 0 || known_sum <= 0.0) return weights;
+  const double known_mean = known_sum / known;
+  for (double& f : failure) {
+    if (f < 0.0) f = known_mean;
+  }
+  const double total = std::accumulate(failure.begin(), failure.end(), 0.0);
+  for (size_t v = 0; v < num_views; ++v) {
+    weights[v] = (1.0 - share) / num_views + share * failure[v] / total;
+  }
+  return weights;
+}
+
+HardViewSampler::HardViewSampler(const TrackingReference& reference,
+                                 double share, double half_life_samples)
+    : share_(share), half_life_samples_(half_life_samples) {
+  if (!(share >= 0.0 && share <= 1.0) || !(half_life_samples > 0.0)) {
+    throw ConfigError(fmt::format(
+        "hard views: share {} (0..1) and half life {} samples (> 0)", share,
+        half_life_samples));
+  }
+  for (const TrackedView& view : reference.views()) {
+    const std::string& bundle = reference.bundles()[view.bundle].name;
+    view_names_.push_back(fmt::format("{} view {}", bundle, view.view));
+    num_frames_.push_back(view.num_frames);
+  }
+  records_.resize(view_names_.size());
+}
+
+void HardViewSampler::Record(const std::vector<FinishedEpisode>& finished,
+                             int64_t batch_samples) {
+  const double keep = std::exp2(-batch_samples / half_life_samples_);
+  for (ViewFailureRecord& record : records_) {
+    record.steps *= keep;
+    record.failures *= keep;
+  }
+  for (const FinishedEpisode& episode : finished) {
+    ViewFailureRecord& record = records_.at(episode.stats.view_index);
+    record.steps += episode.stats.steps;
+    record.failures += episode.stats.failed ? 1.0 : 0.0;
+  }
+}
+
+std::vector<double> HardViewSampler::Weights() const {
+  return HardViewWeights(records_, num_frames_, share_);
+}
+
+std::string HardViewSampler::Report(int count) const {
+  const std::vector<double> weights = Weights();
+  std::vector<int> order(records_.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<double> failure(records_.size());
+  for (size_t v = 0; v < records_.size(); ++v) {
+    failure[v] = FullRolloutFailure(records_[v], num_frames_[v]);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return failure[a] > failure[b]; });
+  std::string report;
+  for (int i = 0; i < std::min<int>(count, order.size()); ++i) {
+    const int v = order[i];
+    if (failure[v] < 0.0) break;
+    report += fmt::format("{}{} {:.2f} (w {:.3f})", report.empty() ? "" : ", ",
+                          view_names_[v], failure[v], weights[v]);
+  }
+  return report.empty() ? "no episodes yet" : report;
+}
+
+}  // namespace m2d

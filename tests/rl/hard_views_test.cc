@@ -1,0 +1,95 @@
+// Hard-view sampling: a view's chance of failing a whole rollout from its
+// training episodes' early exits, and start weights that favour the views
+// that fail, forgetting old episodes with the configured half life.
+#include "rl/hard_views.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "common/error.h"
+#include "env/env_fixture.h"
+#include "env/task.h"
+
+namespace m2d {
+namespace {
+
+TEST(HardViews, AConstantHazardGivesTheWholeRolloutsFailure) {
+  EXPECT_LT(FullRolloutFailure({}, 100), 0.0);  // no steps: unknown
+  EXPECT_DOUBLE_EQ(FullRolloutFailure({500.0, 0.0}, 100), 0.0);
+  // One early exit per 100 steps over a 101-frame view: 1 - e^-1.
+  EXPECT_NEAR(FullRolloutFailure({1000.0, 10.0}, 101), 1.0 - std::exp(-1.0),
+              1e-12);
+  // The longer the view, the likelier a rollout fails at the same rate.
+  EXPECT_GT(FullRolloutFailure({1000.0, 10.0}, 300),
+            FullRolloutFailure({1000.0, 10.0}, 30));
+}
+
+TEST(HardViews, WeightsAreUniformPlusAShareInProportionToFailure) {
+  const std::vector<int> frames = {101, 101, 101};
+  // Nothing known, or nothing fails: uniform.
+  for (const auto& records :
+       {std::vector<ViewFailureRecord>(3),
+        std::vector<ViewFailureRecord>{{100, 0}, {100, 0}, {0, 0}}}) {
+    for (double w : HardViewWeights(records, frames, 0.5)) {
+      EXPECT_DOUBLE_EQ(w, 1.0 / 3.0);
+    }
+  }
+  // View 0 never fails, view 1 does (p = 1 - e^-1), view 2 is unknown and
+  // counts as the known mean (p / 2).
+  const std::vector<ViewFailureRecord> records = {
+      {1000, 0}, {1000, 10}, {0, 0}};
+  const std::vector<double> weights = HardViewWeights(records, frames, 0.6);
+  EXPECT_NEAR(std::accumulate(weights.begin(), weights.end(), 0.0), 1.0, 1e-12);
+  EXPECT_NEAR(weights[0], 0.4 / 3.0, 1e-12);
+  EXPECT_NEAR(weights[1], 0.4 / 3.0 + 0.6 * (2.0 / 3.0), 1e-12);
+  EXPECT_NEAR(weights[2], 0.4 / 3.0 + 0.6 * (1.0 / 3.0), 1e-12);
+  // Share 0: uniform whatever fails.
+  for (double w : HardViewWeights(records, frames, 0.0)) {
+    EXPECT_DOUBLE_EQ(w, 1.0 / 3.0);
+  }
+}
+
+TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
+  SimulationOptions options;
+  auto character = testing::LoadHumanoid(options);
+  std::vector<ReferenceBundle> bundles;
+  bundles.push_back(testing::MakeGlidingBundle(*character, 1.0, 2));
+  TrackingTaskOptions task_options;
+  task_options.simulation = options;
+  TrackingTask task =
+      BuildTrackingTask(character, std::move(bundles), task_options);
+  HardViewSampler sampler(*task.reference, /*share=*/1.0,
+                          /*half_life_samples=*/1000.0);
+  EXPECT_EQ(sampler.Report(3), "no episodes yet");
+
+  // View 0 fails every episode after 5 steps; view 1 tracks 29 steps.
+  auto episode = [](int view, int steps, bool failed) {
+    FinishedEpisode finished;
+    finished.stats.view_index = view;
+    finished.stats.steps = steps;
+    finished.stats.failed = failed;
+    return finished;
+  };
+  sampler.Record({episode(0, 5, true), episode(1, 29, false)}, 1000);
+  std::vector<double> weights = sampler.Weights();
+  EXPECT_DOUBLE_EQ(weights[0], 1.0);  // share 1: only the failing view
+  EXPECT_DOUBLE_EQ(weights[1], 0.0);
+  EXPECT_NE(sampler.Report(1).find("gliding view 0"), std::string::npos);
+  // Later the views swap; after many half lives the old records are gone.
+  for (int i = 0; i < 40; ++i) {
+    sampler.Record({episode(0, 29, false), episode(1, 5, true)}, 1000);
+  }
+  weights = sampler.Weights();
+  EXPECT_LT(weights[0], 1e-6);
+  EXPECT_GT(weights[1], 1.0 - 1e-6);
+  // An episode of a view the reference has not: refused.
+  EXPECT_THROW(sampler.Record({episode(2, 5, true)}, 1000), std::out_of_range);
+  EXPECT_THROW(HardViewSampler(*task.reference, 1.5, 1000.0), ConfigError);
+  EXPECT_THROW(HardViewSampler(*task.reference, 0.5, 0.0), ConfigError);
+}
+
+}  // namespace
+}  // namespace m2d
