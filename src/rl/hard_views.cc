@@ -89,14 +89,24 @@ std::string HardViewSampler::Report(int count) const {
   }
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return failure[a] > failure[b]; });
-  std::string report;
+  double known_sum = 0.0;
+  int known = 0;
+  for (double f : failure) {
+    if (f < 0.0) continue;
+    known_sum += f;
+    ++known;
+  }
+  if (known == 0) return "no episodes yet";
+  std::string report =
+      fmt::format("mean failure chance {:.2f} over {} of {} views; hardest:",
+                  known_sum / known, known, failure.size());
   for (int i = 0; i < std::min<int>(count, order.size()); ++i) {
     const int v = order[i];
     if (failure[v] < 0.0) break;
-    report += fmt::format("{}{} {:.2f} (w {:.3f})", report.empty() ? "" : ", ",
+    report += fmt::format("{} {} {:.2f} (w {:.3f})", i == 0 ? "" : ",",
                           view_names_[v], failure[v], weights[v]);
   }
-  return report.empty() ? "no episodes yet" : report;
+  return report;
 }
 
 }  // namespace m2d

@@ -47,8 +47,9 @@ class HardViewSampler {
   void Record(const std::vector<FinishedEpisode>& finished,
               int64_t batch_samples);
   std::vector<double> Weights() const;
-  // A brief report: the `count` views most likely to fail, with that
-  // probability and their start weight ("kick view 2 0.93 (w 0.061), ...").
+  // A brief report: the mean failure chance over the views with episodes,
+  // then the `count` views most likely to fail, with that chance and their
+  // start weight ("...; hardest: kick view 2 0.93 (w 0.061), ...").
   std::string Report(int count) const;
 
  private:

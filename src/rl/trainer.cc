@@ -432,7 +432,7 @@ TrainSummary Trainer::Run(
     if (SecondsSince(last_checkpoint) > 60.0 * config.run.checkpoint_minutes) {
       s.Save();
       if (s.hard_views) {
-        spdlog::info("hardest views: {}", s.hard_views->Report(5));
+        spdlog::info("hard views: {}", s.hard_views->Report(5));
       }
       last_checkpoint = Clock::now();
     }

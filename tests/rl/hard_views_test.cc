@@ -77,7 +77,13 @@ TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
   std::vector<double> weights = sampler.Weights();
   EXPECT_DOUBLE_EQ(weights[0], 1.0);  // share 1: only the failing view
   EXPECT_DOUBLE_EQ(weights[1], 0.0);
-  EXPECT_NE(sampler.Report(1).find("gliding view 0"), std::string::npos);
+  const std::string report = sampler.Report(1);
+  EXPECT_NE(report.find("mean failure chance 0.50 over 2 of 2 views"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("hardest: gliding view 0 1.00 (w 1.000)"),
+            std::string::npos)
+      << report;
   // Later the views swap; after many half lives the old records are gone.
   for (int i = 0; i < 40; ++i) {
     sampler.Record({episode(0, 29, false), episode(1, 5, true)}, 1000);
