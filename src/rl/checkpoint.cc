@@ -242,6 +242,37 @@ std::optional<uint64_t> SavedReferenceFingerprint(
   return fingerprint;
 }
 
+// The training counters saved in `archive`. Throws c10::Error when absent.
+CheckpointCounters ReadCounters(torch::serialize::InputArchive& archive) {
+  CheckpointCounters counters;
+  // A fresh tensor per read: reading into a defined tensor keeps its
+  // dtype and reinterprets the bytes (a double read as int64).
+  torch::Tensor iteration, samples, wall_time_s, learning_rate;
+  archive.read("iteration", iteration);
+  counters.iteration = static_cast<int>(iteration.item<int64_t>());
+  archive.read("samples", samples);
+  counters.samples = samples.item<int64_t>();
+  archive.read("wall_time_s", wall_time_s);
+  counters.wall_time_s = wall_time_s.item<double>();
+  if (archive.try_read("learning_rate", learning_rate))
+    counters.learning_rate = learning_rate.item<double>();
+  return counters;
+}
+
+// How many ASI buffers `archive` holds (0 for a slim checkpoint).
+int64_t SavedBufferCount(torch::serialize::InputArchive& archive) {
+  torch::Tensor saved_buffers;
+  if (archive.try_read("asi_buffers", saved_buffers)) {
+    return saved_buffers.item<int64_t>();
+  }
+  int64_t num_saved = 0;  // older checkpoints: count the buffers present
+  torch::Tensor probe;
+  while (
+      archive.try_read("asi_" + std::to_string(num_saved) + "_states", probe))
+    ++num_saved;
+  return num_saved;
+}
+
 // Restores the ASI buffers saved in `archive` into `initial_states` (see
 // LoadCheckpoint). Throws c10::Error on malformed tensors.
 void RestoreStateBuffers(const std::string& path,
@@ -251,16 +282,7 @@ void RestoreStateBuffers(const std::string& path,
   const int64_t width = FlatStateSize(state_template);
   // The buffers must be this task's: one per bundle (truth, default
   // starts) or one per view (estimate).
-  torch::Tensor saved_buffers;
-  int64_t num_saved = 0;
-  if (archive.try_read("asi_buffers", saved_buffers)) {
-    num_saved = saved_buffers.item<int64_t>();
-  } else {  // older checkpoints: count the buffers present
-    torch::Tensor probe;
-    while (
-        archive.try_read("asi_" + std::to_string(num_saved) + "_states", probe))
-      ++num_saved;
-  }
+  const int64_t num_saved = SavedBufferCount(archive);
   if (num_saved > 0 && num_saved != initial_states->num_buffers()) {
     throw InputError(path,
                      "holds " + std::to_string(num_saved) +
@@ -323,21 +345,10 @@ CheckpointCounters LoadCheckpoint(const std::string& path, ActorCritic& model,
   CheckpointCounters counters;
   try {
     CheckSameNetwork(path, archive, model);
-    // A fresh tensor per read: reading into a defined tensor keeps its
-    // dtype and reinterprets the bytes (a double read as int64).
-    torch::Tensor iteration, samples, wall_time_s;
-    archive.read("iteration", iteration);
-    counters.iteration = static_cast<int>(iteration.item<int64_t>());
-    archive.read("samples", samples);
-    counters.samples = samples.item<int64_t>();
-    archive.read("wall_time_s", wall_time_s);
-    counters.wall_time_s = wall_time_s.item<double>();
+    counters = ReadCounters(archive);
     torch::serialize::InputArchive model_archive;
     archive.read("model", model_archive);
     model->load(model_archive);
-    torch::Tensor learning_rate;
-    if (archive.try_read("learning_rate", learning_rate))
-      counters.learning_rate = learning_rate.item<double>();
     if (optimizer != nullptr) {
       torch::serialize::InputArchive optimizer_archive;
       archive.read("optimizer", optimizer_archive);
@@ -409,6 +420,24 @@ SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
                  /*initial_states=*/nullptr, SimState());
   summary.bytes_after = static_cast<int64_t>(std::filesystem::file_size(out));
   return summary;
+}
+
+CheckpointInfo ReadCheckpointInfo(const std::string& path) {
+  CheckpointInfo info;
+  info.config = ReadCheckpointConfig(path);
+  info.layout = ReadCheckpointLayout(path, &info.action_size);
+  info.bytes = static_cast<int64_t>(std::filesystem::file_size(path));
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  NamingArchiveErrors(path, "malformed checkpoint", [&] {
+    info.counters = ReadCounters(archive);
+    info.num_state_buffers = static_cast<int>(SavedBufferCount(archive));
+    for (int b = 0; b < info.num_state_buffers; ++b) {
+      torch::Tensor frames;
+      if (archive.try_read("asi_" + std::to_string(b) + "_frames", frames))
+        info.num_buffered_states += frames.numel();
+    }
+  });
+  return info;
 }
 
 }  // namespace m2d

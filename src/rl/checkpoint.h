@@ -70,6 +70,20 @@ struct SlimCheckpointSummary {
 SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
                                           const std::string& out);
 
+// What a checkpoint holds, read without building its task or networks
+// (`mimic2d checkpoint info`).
+struct CheckpointInfo {
+  int64_t bytes = 0;
+  CheckpointCounters counters;
+  TrainConfig config;  // the embedded one
+  ObservationLayout layout;
+  int action_size = 0;
+  int num_state_buffers = 0;        // ASI buffers saved; 0: slim or ASI off
+  int64_t num_buffered_states = 0;  // states over all of them
+};
+// InputError naming the file when it is not a mimic2d checkpoint.
+CheckpointInfo ReadCheckpointInfo(const std::string& path);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_RL_CHECKPOINT_H_

@@ -396,6 +396,13 @@ TEST(Cli, BadInputIsAClearErrorNotACrash) {
 
   ExpectInputError("clip info " + dir + "/absent.json", dir + "/absent.json",
                    "cannot open");
+
+  // A file that is not a training checkpoint, to both checkpoint commands.
+  ExpectInputError("checkpoint info " + malformed, malformed,
+                   "not a mimic2d checkpoint");
+  ExpectInputError("checkpoint slim " + malformed + " -o " + dir + "/out.pt",
+                   malformed, "not a mimic2d checkpoint");
+  EXPECT_FALSE(std::ifstream(dir + "/out.pt").good());
   EXPECT_FALSE(
       std::ifstream(dir + "/out.json").good());  // nothing half-written
 }

@@ -454,7 +454,7 @@ TEST(Checkpoint, InitialStateBuffersOfAnotherTaskAreRejected) {
 
 // `checkpoint slim`: the buffers go, everything a policy or a resumed run
 // reads stays, bit for bit.
-TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffers) {
+TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffersAndInfoSaysSo) {
   const std::string dir = testing::TempDir("checkpoint_slim");
   const std::string path = dir + "/checkpoint.pt";
   const std::string slim_path = dir + "/slim.pt";
@@ -492,6 +492,27 @@ TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffers) {
             static_cast<int64_t>(fs::file_size(slim_path)));
   EXPECT_LT(summary.bytes_after, summary.bytes_before);
 
+  // What each holds, read without building the task: the counters,
+  // config and layout of both, the buffers of the full one only.
+  int64_t num_states = 0;
+  for (int f = 0; f < buffer.num_frames(); ++f) num_states += buffer.size(f);
+  const CheckpointInfo full_info = ReadCheckpointInfo(path);
+  const CheckpointInfo slim_info = ReadCheckpointInfo(slim_path);
+  for (const CheckpointInfo* info : {&full_info, &slim_info}) {
+    EXPECT_EQ(info->counters.iteration, 12);
+    EXPECT_EQ(info->counters.samples, 4242);
+    EXPECT_EQ(info->counters.learning_rate, 1.75e-5);
+    EXPECT_EQ(info->config.ppo.num_envs, 24);
+    EXPECT_EQ(info->action_size, kActions);
+    EXPECT_EQ(info->layout.num_points, SmallLayout().num_points);
+  }
+  EXPECT_EQ(full_info.bytes, summary.bytes_before);
+  EXPECT_EQ(full_info.num_state_buffers, 1);
+  EXPECT_EQ(full_info.num_buffered_states, num_states);
+  EXPECT_EQ(slim_info.bytes, summary.bytes_after);
+  EXPECT_EQ(slim_info.num_state_buffers, 0);
+  EXPECT_EQ(slim_info.num_buffered_states, 0);
+
   // Networks, normalizer, Adam's moments and rate, counters: as saved.
   TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 2);
   InitialStates fresh(*task.reference, character, options.simulation,
@@ -523,6 +544,7 @@ TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffers) {
   const std::string text_path = dir + "/notes.txt";
   std::ofstream(text_path) << "not a checkpoint\n";
   EXPECT_THROW(WriteSlimCheckpoint(text_path, dir + "/out.pt"), InputError);
+  EXPECT_THROW(ReadCheckpointInfo(text_path), InputError);
   EXPECT_FALSE(fs::exists(dir + "/out.pt"));
   fs::remove_all(dir);
 }
