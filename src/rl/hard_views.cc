@@ -16,31 +16,49 @@ double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
   return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
 }
 
+namespace {
+
+// Each view's FullRolloutFailure (negative: no episodes yet), and how many
+// views have episodes, with the mean of their chances.
+struct FailureChances {
+  std::vector<double> per_view;
+  int known = 0;
+  double known_mean = 0.0;
+};
+
+FailureChances ChancesOf(const std::vector<ViewFailureRecord>& records,
+                         const std::vector<int>& num_frames) {
+  FailureChances chances;
+  double known_sum = 0.0;
+  for (size_t v = 0; v < records.size(); ++v) {
+    chances.per_view.push_back(FullRolloutFailure(records[v], num_frames[v]));
+    if (chances.per_view.back() < 0.0) continue;
+    known_sum += chances.per_view.back();
+    ++chances.known;
+  }
+  if (chances.known > 0) chances.known_mean = known_sum / chances.known;
+  return chances;
+}
+
+}  // namespace
+
 std::vector<double> HardViewWeights(
     const std::vector<ViewFailureRecord>& records,
     const std::vector<int>& num_frames, double share) {
-  // Outline: each view's failure probability (unknown ones at the known
-  // mean), then the uniform part plus the share in proportion to them.
+  // Outline: each view's failure chance (unknown ones at the known mean),
+  // then the uniform part plus the share in proportion to them.
   const size_t num_views = records.size();
   std::vector<double> weights(num_views, 1.0 / num_views);
-  std::vector<double> failure(num_views);
-  double known_sum = 0.0;
-  int known = 0;
-  for (size_t v = 0; v < num_views; ++v) {
-    failure[v] = FullRolloutFailure(records[v], num_frames[v]);
-    if (failure[v] >= 0.0) {
-      known_sum += failure[v];
-      ++known;
-    }
+  FailureChances chances = ChancesOf(records, num_frames);
+  if (chances.known == 0 || chances.known_mean <= 0.0) return weights;
+  for (double& f : chances.per_view) {
+    if (f < 0.0) f = chances.known_mean;
   }
-  if (known == 0 || known_sum <= 0.0) return weights;
-  const double known_mean = known_sum / known;
-  for (double& f : failure) {
-    if (f < 0.0) f = known_mean;
-  }
-  const double total = std::accumulate(failure.begin(), failure.end(), 0.0);
+  const double total =
+      std::accumulate(chances.per_view.begin(), chances.per_view.end(), 0.0);
   for (size_t v = 0; v < num_views; ++v) {
-    weights[v] = (1.0 - share) / num_views + share * failure[v] / total;
+    weights[v] =
+        (1.0 - share) / num_views + share * chances.per_view[v] / total;
   }
   return weights;
 }
@@ -80,26 +98,17 @@ std::vector<double> HardViewSampler::Weights() const {
 }
 
 std::string HardViewSampler::Report(int count) const {
+  const FailureChances chances = ChancesOf(records_, num_frames_);
+  if (chances.known == 0) return "no episodes yet";
+  const std::vector<double>& failure = chances.per_view;
   const std::vector<double> weights = Weights();
   std::vector<int> order(records_.size());
   std::iota(order.begin(), order.end(), 0);
-  std::vector<double> failure(records_.size());
-  for (size_t v = 0; v < records_.size(); ++v) {
-    failure[v] = FullRolloutFailure(records_[v], num_frames_[v]);
-  }
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return failure[a] > failure[b]; });
-  double known_sum = 0.0;
-  int known = 0;
-  for (double f : failure) {
-    if (f < 0.0) continue;
-    known_sum += f;
-    ++known;
-  }
-  if (known == 0) return "no episodes yet";
   std::string report =
       fmt::format("mean failure chance {:.2f} over {} of {} views; hardest:",
-                  known_sum / known, known, failure.size());
+                  chances.known_mean, chances.known, failure.size());
   for (int i = 0; i < std::min<int>(count, order.size()); ++i) {
     const int v = order[i];
     if (failure[v] < 0.0) break;

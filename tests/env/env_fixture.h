@@ -58,6 +58,16 @@ inline ReferenceBundle MakeGlidingBundle(const Character& character,
       character.keypoint_map(), options, "gliding");
 }
 
+// A tracking task (default sources and options) on MakeGlidingBundle's
+// motion seen by `num_views` static cameras.
+inline TrackingTask MakeGlidingTask(int num_views, double duration_s = 1.0) {
+  TrackingTaskOptions options;
+  auto character = LoadHumanoid(options.simulation);
+  std::vector<ReferenceBundle> bundles;
+  bundles.push_back(MakeGlidingBundle(*character, duration_s, num_views));
+  return BuildTrackingTask(character, std::move(bundles), options);
+}
+
 // A scripted controller without LibTorch: every PD target at the centre of
 // its range, whatever it observes. It cannot walk.
 class ZeroPolicy : public Policy {

@@ -229,14 +229,7 @@ TEST(InitialStates, AnEstimatedStateIsTheBufferFilledFromTheEstimate) {
 }
 
 TEST(InitialStates, EpisodesStartOnViewsInProportionToTheirWeights) {
-  SimulationOptions options;
-  auto character = testing::LoadHumanoid(options);
-  std::vector<ReferenceBundle> bundles;
-  bundles.push_back(testing::MakeGlidingBundle(*character, 1.0, 3));
-  TrackingTaskOptions task_options;
-  task_options.simulation = options;
-  TrackingTask task =
-      BuildTrackingTask(character, std::move(bundles), task_options);
+  TrackingTask task = testing::MakeGlidingTask(/*num_views=*/3);
   InitialStates& states = *task.initial_states;
   ASSERT_EQ(states.num_views(), 3);
 
@@ -255,7 +248,7 @@ TEST(InitialStates, EpisodesStartOnViewsInProportionToTheirWeights) {
   EXPECT_NEAR(counts[2] / 4000.0, 0.25, 0.03);
   // The environments' episodes follow them.
   states.SetViewWeights({0.0, 0.0, 1.0});
-  TrackingEnv env(character, task.reference, task.initial_states,
+  TrackingEnv env(task.character, task.reference, task.initial_states,
                   TrackingEnvOptions(), /*seed=*/3);
   std::vector<float> observation(env.observation_size());
   for (int i = 0; i < 20; ++i) {

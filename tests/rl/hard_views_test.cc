@@ -53,14 +53,7 @@ TEST(HardViews, WeightsAreUniformPlusAShareInProportionToFailure) {
 }
 
 TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
-  SimulationOptions options;
-  auto character = testing::LoadHumanoid(options);
-  std::vector<ReferenceBundle> bundles;
-  bundles.push_back(testing::MakeGlidingBundle(*character, 1.0, 2));
-  TrackingTaskOptions task_options;
-  task_options.simulation = options;
-  TrackingTask task =
-      BuildTrackingTask(character, std::move(bundles), task_options);
+  TrackingTask task = testing::MakeGlidingTask(/*num_views=*/2);
   HardViewSampler sampler(*task.reference, /*share=*/1.0,
                           /*half_life_samples=*/1000.0);
   EXPECT_EQ(sampler.Report(3), "no episodes yet");
