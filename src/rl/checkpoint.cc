@@ -128,10 +128,9 @@ torch::serialize::InputArchive OpenArchive(const std::string& path) {
   return ReadArchiveFile(path, kCheckpointFormat);
 }
 
-}  // namespace
-
-TrainConfig ReadCheckpointConfig(const std::string& path) {
-  torch::serialize::InputArchive archive = OpenArchive(path);
+// The config embedded in `archive`, read from the file `path`.
+TrainConfig EmbeddedConfig(const std::string& path,
+                           torch::serialize::InputArchive& archive) {
   c10::IValue text;
   NamingArchiveErrors(path, "no readable embedded config", [&] {
     archive.read("config_yaml", text);
@@ -140,9 +139,10 @@ TrainConfig ReadCheckpointConfig(const std::string& path) {
   return LoadTrainConfigText(text.toStringRef(), path + " (embedded config)");
 }
 
-ObservationLayout ReadCheckpointLayout(const std::string& path,
-                                       int* action_size) {
-  torch::serialize::InputArchive archive = OpenArchive(path);
+// The layout and action size saved in `archive`, read from `path`.
+ObservationLayout SavedLayout(const std::string& path,
+                              torch::serialize::InputArchive& archive,
+                              int* action_size) {
   return NamingArchiveErrors(path, "malformed layout", [&] {
     torch::Tensor values;
     archive.read("layout", values);
@@ -169,6 +169,19 @@ ObservationLayout ReadCheckpointLayout(const std::string& path,
     *action_size = count(4, "action_size", 1, 1000);
     return layout;
   });
+}
+
+}  // namespace
+
+TrainConfig ReadCheckpointConfig(const std::string& path) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  return EmbeddedConfig(path, archive);
+}
+
+ObservationLayout ReadCheckpointLayout(const std::string& path,
+                                       int* action_size) {
+  torch::serialize::InputArchive archive = OpenArchive(path);
+  return SavedLayout(path, archive, action_size);
 }
 
 namespace {
@@ -423,11 +436,12 @@ SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
 }
 
 CheckpointInfo ReadCheckpointInfo(const std::string& path) {
+  // One read of the file (a checkpoint with buffers is tens of MB).
   CheckpointInfo info;
-  info.config = ReadCheckpointConfig(path);
-  info.layout = ReadCheckpointLayout(path, &info.action_size);
-  info.bytes = static_cast<int64_t>(std::filesystem::file_size(path));
   torch::serialize::InputArchive archive = OpenArchive(path);
+  info.config = EmbeddedConfig(path, archive);
+  info.layout = SavedLayout(path, archive, &info.action_size);
+  info.bytes = static_cast<int64_t>(std::filesystem::file_size(path));
   NamingArchiveErrors(path, "malformed checkpoint", [&] {
     info.counters = ReadCounters(archive);
     info.num_state_buffers = static_cast<int>(SavedBufferCount(archive));
