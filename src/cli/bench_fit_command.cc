@@ -158,8 +158,9 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
                 "Also print the table as Markdown (for docs/fit.md)");
   fit->add_flag("--from-truth", args->from_truth,
                 "Also refine each view from its true camera and poses "
-                "(stages 2-4): the objective's minimum near the truth, and "
-                "the fits whose search missed a lower cost");
+                "(stages 2-4): the objective's minimum near the truth, the "
+                "fits whose search missed a lower cost, and stage 3's "
+                "terms at the truth and at the fit");
   fit->add_flag("--quick", args->quick,
                 "Only the walk, clean 2D, setting A, one view (a smoke test)")
       ->excludes(clips)

@@ -272,6 +272,17 @@ FitBenchmarkResult RunFitBenchmark(const Character& character,
                   refined.summary.initial_cost, truth_started.pa_mpjpe_mm,
                   truth_started.mean_reprojection_px, truth_started.final_cost,
                   accuracy.final_cost, missed ? ": the search missed it" : ""));
+              // Which terms prefer the fit: stage 3's objective, term by
+              // term, at the (clamped) truth and at the fit.
+              report("    stage 3's terms at the truth: " +
+                     ExplainCost(view.clip, character, fit_options,
+                                 view.cameras, bundle.ground_truth->poses,
+                                 source + " (truth)")
+                         .BriefReport());
+              report("    stage 3's terms at the fit:   " +
+                     ExplainCost(view.clip, character, fit_options,
+                                 estimate.cameras, estimate.poses, source)
+                         .BriefReport());
               row.from_truth.push_back(truth_started);
               from_truth.push_back(truth_started);
               if (missed) ++result.num_search_misses;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "common/error.h"
 #include "fit/camera_model.h"
@@ -603,6 +604,24 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
   return mask;
 }
 
+// Which term each residual block of a problem is, for ExplainCost. A
+// FrameCost block is recorded as kReprojection and split by its residual
+// layout (costs.h) when evaluated.
+struct TermBlock {
+  FitTerm term;
+  ceres::ResidualBlockId id;
+};
+using TermBlocks = std::vector<TermBlock>;
+
+// Adds a residual block of `cost` over `blocks` to `problem`, recorded as
+// `term` when `term_blocks` is given.
+void AddTerm(ceres::Problem& problem, TermBlocks* term_blocks, FitTerm term,
+             ceres::CostFunction* cost, const std::vector<double*>& blocks) {
+  const ceres::ResidualBlockId id =
+      problem.AddResidualBlock(cost, nullptr, blocks);
+  if (term_blocks != nullptr) term_blocks->push_back({term, id});
+}
+
 // The mean-balance terms (costs.h LeanCost), each of `weight`: the clip cut
 // into windows of window_s; in each, the frames with a sole in contact
 // (weight >= 0.5) get a term that moves their centre of mass's offset from
@@ -610,7 +629,8 @@ std::vector<double> TorsoMask(const KeypointLayout& layout) {
 // quarter of its frames in contact (a flight) has none.
 void AddMeanBalance(const KinematicModel& model, double weight, double window_s,
                     double fps, const ContactWeights& contacts,
-                    Parameters& params, ceres::Problem& problem) {
+                    Parameters& params, ceres::Problem& problem,
+                    TermBlocks* term_blocks) {
   const int num_frames = static_cast<int>(params.root_m.size());
   const int window = std::max(2, static_cast<int>(std::lround(window_s * fps)));
   const auto points = FramePoints(params, model);
@@ -651,21 +671,21 @@ void AddMeanBalance(const KinematicModel& model, double weight, double window_s,
       terms[i].target_m[0] -= mean_offset_m.x();
       terms[i].target_m[1] -= mean_offset_m.y();
       const int t = frames[i];
-      problem.AddResidualBlock(
-          LeanCost::Create(std::move(terms[i])), nullptr,
-          {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-           params.hinges_rad[t].data()});
+      AddTerm(problem, term_blocks, FitTerm::kMeanBalance,
+              LeanCost::Create(std::move(terms[i])),
+              {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+               params.hinges_rad[t].data()});
     }
   }
 }
 
 // Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
-// them out).
+// them out); `term_blocks` (optional) records which term each block is.
 void BuildProblem(Stage stage, const Observations& obs,
                   const KinematicModel& model, const KeypointLayout& layout,
                   const FitOptions& options, const FitPriors& priors,
                   const ContactWeights* contacts, Parameters& params,
-                  ceres::Problem& problem) {
+                  ceres::Problem& problem, TermBlocks* term_blocks = nullptr) {
   const int num_frames = obs.num_frames;
   const int num_hinges = model.num_hinges();
   const std::vector<double> torso = TorsoMask(layout);
@@ -688,22 +708,23 @@ void BuildProblem(Stage stage, const Observations& obs,
       cost.weights.push_back(obs.Weight(t, j) *
                              (stage == Stage::kRoot ? torso[j] : 1.0));
     }
-    problem.AddResidualBlock(
-        FrameCost::Create(std::move(cost)), nullptr,
-        {&params.focal_px, params.pitch_roll_rad, params.centre(t),
-         params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-         params.hinges_rad[t].data()});
+    AddTerm(problem, term_blocks, FitTerm::kReprojection,
+            FrameCost::Create(std::move(cost)),
+            {&params.focal_px, params.pitch_roll_rad, params.centre(t),
+             params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+             params.hinges_rad[t].data()});
   }
   // Temporal smoothness of the root and of its orientation.
   for (int t = 1; t + 1 < num_frames; ++t) {
-    problem.AddResidualBlock(
-        AccelerationCost::Create(3, options.root_smooth_weight), nullptr,
-        {params.root_m[t - 1].data(), params.root_m[t].data(),
-         params.root_m[t + 1].data()});
-    problem.AddResidualBlock(
-        TurnAccelerationCost::Create(options.turn_smooth_weight), nullptr,
-        params.quaternion_wxyz[t - 1].data(), params.quaternion_wxyz[t].data(),
-        params.quaternion_wxyz[t + 1].data());
+    AddTerm(problem, term_blocks, FitTerm::kRootSmooth,
+            AccelerationCost::Create(3, options.root_smooth_weight),
+            {params.root_m[t - 1].data(), params.root_m[t].data(),
+             params.root_m[t + 1].data()});
+    AddTerm(
+        problem, term_blocks, FitTerm::kTurnSmooth,
+        TurnAccelerationCost::Create(options.turn_smooth_weight),
+        {params.quaternion_wxyz[t - 1].data(), params.quaternion_wxyz[t].data(),
+         params.quaternion_wxyz[t + 1].data()});
   }
   // The pose: prior toward rest, smooth in time, within the joint ranges;
   // held at rest in stage 1.
@@ -714,25 +735,25 @@ void BuildProblem(Stage stage, const Observations& obs,
       continue;
     }
     if (priors.pose_mixture != nullptr) {
-      problem.AddResidualBlock(
-          new MixturePriorCost(priors.pose_mixture.get(),
-                               stage == Stage::kRefine
-                                   ? options.refine_mixture_weight
-                               : stage == Stage::kPoseWithContacts
-                                   ? options.pose_mixture_final_weight
-                                   : options.pose_mixture_weight),
-          nullptr, hinges);
+      AddTerm(problem, term_blocks, FitTerm::kPosePrior,
+              new MixturePriorCost(priors.pose_mixture.get(),
+                                   stage == Stage::kRefine
+                                       ? options.refine_mixture_weight
+                                   : stage == Stage::kPoseWithContacts
+                                       ? options.pose_mixture_final_weight
+                                       : options.pose_mixture_weight),
+              {hinges});
     } else {
-      problem.AddResidualBlock(
-          PriorCost::Create(num_hinges, options.pose_prior_weight), nullptr,
-          {hinges});
+      AddTerm(problem, term_blocks, FitTerm::kPosePrior,
+              PriorCost::Create(num_hinges, options.pose_prior_weight),
+              {hinges});
     }
     if (t >= 1 && t + 1 < num_frames) {
-      problem.AddResidualBlock(
+      AddTerm(
+          problem, term_blocks, FitTerm::kPoseSmooth,
           AccelerationCost::Create(
               num_hinges, stage == Stage::kRefine ? options.refine_smooth_weight
                                                   : options.pose_smooth_weight),
-          nullptr,
           {params.hinges_rad[t - 1].data(), hinges,
            params.hinges_rad[t + 1].data()});
     }
@@ -755,12 +776,12 @@ void BuildProblem(Stage stage, const Observations& obs,
         cost.contact_weights.push_back(weight);
       }
       if (!any) continue;
-      problem.AddResidualBlock(
-          FootSlideCost::Create(std::move(cost)), nullptr,
-          {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-           params.hinges_rad[t].data(), params.root_m[t + 1].data(),
-           params.quaternion_wxyz[t + 1].data(),
-           params.hinges_rad[t + 1].data()});
+      AddTerm(problem, term_blocks, FitTerm::kFootSlide,
+              FootSlideCost::Create(std::move(cost)),
+              {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+               params.hinges_rad[t].data(), params.root_m[t + 1].data(),
+               params.quaternion_wxyz[t + 1].data(),
+               params.hinges_rad[t + 1].data()});
     }
   }
   // The zero-moment point over the support, where a sole is in contact.
@@ -786,8 +807,8 @@ void BuildProblem(Stage stage, const Observations& obs,
                                      params.quaternion_wxyz[f].data(),
                                      params.hinges_rad[f].data()});
       }
-      problem.AddResidualBlock(BalanceCost::Create(std::move(cost)), nullptr,
-                               blocks);
+      AddTerm(problem, term_blocks, FitTerm::kBalance,
+              BalanceCost::Create(std::move(cost)), blocks);
     }
   }
   // Balance on average: per window, the mean offset of the centre of mass
@@ -799,7 +820,7 @@ void BuildProblem(Stage stage, const Observations& obs,
   if (HasContactTerms(stage) && contacts != nullptr &&
       mean_balance_weight > 0) {
     AddMeanBalance(model, mean_balance_weight, options.mean_balance_window_s,
-                   obs.fps, *contacts, params, problem);
+                   obs.fps, *contacts, params, problem, term_blocks);
   }
   // Orientation blocks live on the unit quaternions.
   for (int t = 0; t < num_frames; ++t) {
@@ -811,9 +832,10 @@ void BuildProblem(Stage stage, const Observations& obs,
     if (options.fixed_focal_px > 0) {
       problem.SetParameterBlockConstant(&params.focal_px);
     } else {
-      problem.AddResidualBlock(
+      AddTerm(
+          problem, term_blocks, FitTerm::kFocalPrior,
           FocalPriorCost::Create(priors.focal_px, options.focal_prior_weight),
-          nullptr, &params.focal_px);
+          {&params.focal_px});
       problem.SetParameterLowerBound(&params.focal_px, 0,
                                      0.1 * priors.focal_px);
       problem.SetParameterUpperBound(&params.focal_px, 0,
@@ -822,9 +844,10 @@ void BuildProblem(Stage stage, const Observations& obs,
     // Most footage is shot level (a tripod, a person holding a phone
     // upright); without this a body's sideways lean hides in camera roll.
     if (options.camera_roll_prior_weight > 0) {
-      problem.AddResidualBlock(
+      AddTerm(
+          problem, term_blocks, FitTerm::kCameraRollPrior,
           CameraRollPriorCost::Create(0.0, options.camera_roll_prior_weight),
-          nullptr, params.pitch_roll_rad);
+          {params.pitch_roll_rad});
     }
     problem.SetParameterLowerBound(params.pitch_roll_rad, 0, -1.3);
     problem.SetParameterUpperBound(params.pitch_roll_rad, 0, 1.3);
@@ -843,23 +866,23 @@ void BuildProblem(Stage stage, const Observations& obs,
     // A person filming stands (or a tripod stands) about this high; spread
     // over a moving camera's frames so its strength does not grow with
     // the clip.
-    problem.AddResidualBlock(
-        CameraHeightPriorCost::Create(
-            options.camera_height_prior_m,
-            (num_centres > 1 ? options.moving_camera_height_prior_weight
-                             : options.camera_height_prior_weight) /
-                std::sqrt(num_centres)),
-        nullptr, centre);
+    AddTerm(problem, term_blocks, FitTerm::kCameraHeightPrior,
+            CameraHeightPriorCost::Create(
+                options.camera_height_prior_m,
+                (num_centres > 1 ? options.moving_camera_height_prior_weight
+                                 : options.camera_height_prior_weight) /
+                    std::sqrt(num_centres)),
+            {centre});
   }
   for (int c = 1; c < num_centres; ++c) {
-    problem.AddResidualBlock(VelocityCost::Create(options.camera_speed_weight),
-                             nullptr, params.centres_m[c - 1].data(),
-                             params.centres_m[c].data());
+    AddTerm(problem, term_blocks, FitTerm::kCameraSpeed,
+            VelocityCost::Create(options.camera_speed_weight),
+            {params.centres_m[c - 1].data(), params.centres_m[c].data()});
     if (c + 1 < num_centres) {
-      problem.AddResidualBlock(
-          AccelerationCost::Create(3, options.camera_smooth_weight), nullptr,
-          {params.centres_m[c - 1].data(), params.centres_m[c].data(),
-           params.centres_m[c + 1].data()});
+      AddTerm(problem, term_blocks, FitTerm::kCameraSmooth,
+              AccelerationCost::Create(3, options.camera_smooth_weight),
+              {params.centres_m[c - 1].data(), params.centres_m[c].data(),
+               params.centres_m[c + 1].data()});
     }
   }
   // Stage 4 refines the pose under the camera the search settled on: with
@@ -1107,6 +1130,24 @@ std::string DescribeCamera(const Parameters& params) {
 // Stages 2 and 3 from `best` (the full pose, then contacts), and the
 // estimate with its account: per-frame residuals, the frames that did not
 // converge, the summary.
+// The contacts of the estimate `params`, gated by the feet standing still:
+// seen in the 2D (static camera, contacts_from_2d) or by the fitted feet's
+// speed.
+ContactWeights CurrentContacts(const Observations& obs,
+                               const KinematicModel& model,
+                               const KeypointLayout& layout,
+                               const FitOptions& options, Parameters& params) {
+  const auto points = FramePoints(params, model);
+  if (options.camera_motion != CameraMotion::kStatic ||
+      !options.contacts_from_2d) {
+    return EstimateContacts(points, model, options, obs.fps, true);
+  }
+  const double rest_scale_m = MakeRestPose(model, layout).scale_m;
+  const std::vector<std::vector<FootIn2d>> feet = ObservedFeet(
+      obs, model, FootAnkles(model, layout, points), rest_scale_m, options);
+  return EstimateContacts(points, model, options, obs.fps, true, &feet);
+}
+
 ViewEstimate SolvePoseAndReport(const Observations& obs,
                                 const KinematicModel& model,
                                 const KeypointLayout& layout,
@@ -1130,16 +1171,8 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   // The contacts of the current estimate, gated by the feet standing
   // still: seen in the 2D (static camera, contacts_from_2d) or by the
   // fitted feet's speed.
-  const double rest_scale_m = MakeRestPose(model, layout).scale_m;
   auto current_contacts = [&]() {
-    const auto points = FramePoints(best, model);
-    if (options.camera_motion != CameraMotion::kStatic ||
-        !options.contacts_from_2d) {
-      return EstimateContacts(points, model, options, obs.fps, true);
-    }
-    const std::vector<std::vector<FootIn2d>> feet = ObservedFeet(
-        obs, model, FootAnkles(model, layout, points), rest_scale_m, options);
-    return EstimateContacts(points, model, options, obs.fps, true, &feet);
+    return CurrentContacts(obs, model, layout, options, best);
   };
 
   // Stage 3: feet that do not slide, at the contacts the previous solve
@@ -1210,6 +1243,125 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
           .count();
   estimate.summary = summary;
   return estimate;
+}
+
+// `cameras` (1, or one per frame) and `poses` in the fit's frame (the
+// camera's yaw 0, its first centre above the origin), every hinge clamped
+// into its range: a start for the stages, or a state to explain. Throws
+// InputError naming `source` when they do not match the frames.
+Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
+                           const Character& character,
+                           const FitOptions& options,
+                           const std::vector<PinholeCamera>& cameras,
+                           const std::vector<Pose3D>& poses,
+                           const std::string& source) {
+  if (static_cast<int>(poses.size()) != obs.num_frames) {
+    throw InputError(source, "the start has " + std::to_string(poses.size()) +
+                                 " poses for " +
+                                 std::to_string(obs.num_frames) + " frames");
+  }
+  if (cameras.empty() || (cameras.size() != 1 &&
+                          static_cast<int>(cameras.size()) != obs.num_frames)) {
+    throw InputError(source, "the start has " + std::to_string(cameras.size()) +
+                                 " cameras; expected 1 or one per frame");
+  }
+  const PinholeCamera& camera = cameras.front();
+  Parameters params;
+  params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
+                                               : camera.intrinsics().fx_px;
+  const Eigen::Vector2d pitch_roll = CameraPitchRollRad(camera);
+  params.pitch_roll_rad[0] = pitch_roll[0];
+  params.pitch_roll_rad[1] = pitch_roll[1];
+  // The world turned about z so that the camera looks along +x, and moved
+  // so that its centre is above the origin.
+  const Eigen::Matrix3d turn =
+      FitCameraRotation(params.pitch_roll_rad).transpose() *
+      camera.rotation_world_to_camera();
+  const Eigen::Vector3d centre = camera.CenterWorld();
+  const Eigen::Vector3d shift(centre.x(), centre.y(), 0.0);
+  // A moving camera keeps its first orientation (the fit's model).
+  for (int c = 0;
+       c <
+       (options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1);
+       ++c) {
+    const PinholeCamera& at = cameras[std::min<size_t>(c, cameras.size() - 1)];
+    params.centres_m.push_back(turn * (at.CenterWorld() - shift));
+  }
+  std::vector<double> qpos(character.model()->nq, 0.0);
+  const Eigen::Quaterniond turn_quaternion(turn);
+  for (const Pose3D& pose : poses) {
+    PoseToQpos(character, pose, qpos.data());
+    params.root_m.push_back(
+        turn * (Eigen::Vector3d(qpos[0], qpos[1], qpos[2]) - shift));
+    const Eigen::Quaterniond root =
+        turn_quaternion *
+        Eigen::Quaterniond(qpos[3], qpos[4], qpos[5], qpos[6]);
+    params.quaternion_wxyz.emplace_back(root.w(), root.x(), root.y(), root.z());
+    std::vector<double> hinges(model.num_hinges());
+    for (int h = 0; h < model.num_hinges(); ++h) {
+      hinges[h] = std::clamp(qpos[character.hinges()[h].qpos_address],
+                             model.hinge_low_rad[h], model.hinge_high_rad[h]);
+    }
+    params.hinges_rad.push_back(std::move(hinges));
+  }
+  return params;
+}
+
+// A given state (cameras and poses) read against its clip, in the fit's
+// frame: what RefineView starts from and ExplainCost evaluates.
+struct GivenState {
+  KinematicModel model;
+  Observations obs;
+  Parameters params;
+  FitPriors priors;
+
+  GivenState(const Clip2D& clip, const Character& character,
+             const FitOptions& options,
+             const std::vector<PinholeCamera>& cameras,
+             const std::vector<Pose3D>& poses, const std::string& source)
+      : model(KinematicModel::FromCharacter(character)),
+        obs(ReadCharacterObservations(clip, character, options, source)),
+        params(GivenParameters(obs, model, character, options, cameras, poses,
+                               source)),
+        priors(MakeFitPriors(character, model, *clip.layout, options, obs,
+                             source)) {}
+};
+
+// The cost of `blocks` in `problem`, term by term (1/2 the squared
+// residuals each; FrameCost blocks split by their residual layout:
+// reprojection, ground, penetration, upright; costs.h).
+FitTermCosts EvaluateTerms(ceres::Problem& problem, const TermBlocks& blocks,
+                           const KinematicModel& model) {
+  ceres::Problem::EvaluateOptions evaluate;
+  for (const TermBlock& block : blocks)
+    evaluate.residual_blocks.push_back(block.id);
+  double total = 0.0;
+  std::vector<double> residuals;
+  problem.Evaluate(evaluate, &total, &residuals, nullptr, nullptr);
+  FitTermCosts costs;
+  size_t at = 0;
+  auto half_squares = [&](int count) {
+    double sum = 0.0;
+    for (int i = 0; i < count; ++i, ++at) sum += residuals[at] * residuals[at];
+    return 0.5 * sum;
+  };
+  for (const TermBlock& block : blocks) {
+    const int count =
+        problem.GetCostFunctionForResidualBlock(block.id)->num_residuals();
+    if (block.term != FitTerm::kReprojection) {
+      costs[block.term] += half_squares(count);
+      continue;
+    }
+    costs[FitTerm::kReprojection] += half_squares(2 * model.num_keypoints());
+    costs[FitTerm::kGround] += half_squares(1);
+    costs[FitTerm::kPenetration] += half_squares(model.num_sole_points());
+    costs[FitTerm::kUpright] += half_squares(2);
+  }
+  if (at != residuals.size()) {
+    throw std::logic_error(
+        "EvaluateTerms: FrameCost's residual layout changed");
+  }
+  return costs;
 }
 
 }  // namespace
@@ -1354,65 +1506,15 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                         const std::vector<Pose3D>& poses,
                         const std::string& source) {
   // Outline: read the observations; express the camera and poses in the
-  // fit's frame (the camera's yaw 0, its first centre above the origin),
-  // with every hinge clamped into its range; stages 2 to 4 as FitView;
-  // report.
+  // fit's frame, with every hinge clamped into its range; stages 2 to 4 as
+  // FitView; report.
   options.Validate();
   const auto started = std::chrono::steady_clock::now();
-  const KinematicModel model = KinematicModel::FromCharacter(character);
-  const Observations obs =
-      ReadCharacterObservations(clip, character, options, source);
-  if (static_cast<int>(poses.size()) != obs.num_frames) {
-    throw InputError(source, "the start has " + std::to_string(poses.size()) +
-                                 " poses for " +
-                                 std::to_string(obs.num_frames) + " frames");
-  }
-  if (cameras.empty() || (cameras.size() != 1 &&
-                          static_cast<int>(cameras.size()) != obs.num_frames)) {
-    throw InputError(source, "the start has " + std::to_string(cameras.size()) +
-                                 " cameras; expected 1 or one per frame");
-  }
-  const PinholeCamera& camera = cameras.front();
-  const FitPriors priors =
-      MakeFitPriors(character, model, *clip.layout, options, obs, source);
-  Parameters params;
-  params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
-                                               : camera.intrinsics().fx_px;
-  const Eigen::Vector2d pitch_roll = CameraPitchRollRad(camera);
-  params.pitch_roll_rad[0] = pitch_roll[0];
-  params.pitch_roll_rad[1] = pitch_roll[1];
-  // The world turned about z so that the camera looks along +x, and moved
-  // so that its centre is above the origin.
-  const Eigen::Matrix3d turn =
-      FitCameraRotation(params.pitch_roll_rad).transpose() *
-      camera.rotation_world_to_camera();
-  const Eigen::Vector3d centre = camera.CenterWorld();
-  const Eigen::Vector3d shift(centre.x(), centre.y(), 0.0);
-  // A moving camera keeps its first orientation (the fit's model).
-  for (int c = 0;
-       c <
-       (options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1);
-       ++c) {
-    const PinholeCamera& at = cameras[std::min<size_t>(c, cameras.size() - 1)];
-    params.centres_m.push_back(turn * (at.CenterWorld() - shift));
-  }
-  std::vector<double> qpos(character.model()->nq, 0.0);
-  const Eigen::Quaterniond turn_quaternion(turn);
-  for (const Pose3D& pose : poses) {
-    PoseToQpos(character, pose, qpos.data());
-    params.root_m.push_back(
-        turn * (Eigen::Vector3d(qpos[0], qpos[1], qpos[2]) - shift));
-    const Eigen::Quaterniond root =
-        turn_quaternion *
-        Eigen::Quaterniond(qpos[3], qpos[4], qpos[5], qpos[6]);
-    params.quaternion_wxyz.emplace_back(root.w(), root.x(), root.y(), root.z());
-    std::vector<double> hinges(model.num_hinges());
-    for (int h = 0; h < model.num_hinges(); ++h) {
-      hinges[h] = std::clamp(qpos[character.hinges()[h].qpos_address],
-                             model.hinge_low_rad[h], model.hinge_high_rad[h]);
-    }
-    params.hinges_rad.push_back(std::move(hinges));
-  }
+  GivenState given(clip, character, options, cameras, poses, source);
+  const KinematicModel& model = given.model;
+  const Observations& obs = given.obs;
+  Parameters& params = given.params;
+  const FitPriors& priors = given.priors;
   FitSummary summary;
   summary.camera_model = CameraMotionName(options.camera_motion);
   summary.focal_fixed = options.fixed_focal_px > 0;
@@ -1425,6 +1527,87 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                              .initial_cost;
   return SolvePoseAndReport(obs, model, *clip.layout, character, options,
                             priors, started, summary, params);
+}
+
+FitTermCosts ExplainCost(const Clip2D& clip, const Character& character,
+                         const FitOptions& options,
+                         const std::vector<PinholeCamera>& cameras,
+                         const std::vector<Pose3D>& poses,
+                         const std::string& source) {
+  // Outline: the state in the fit's frame; its own contacts; stage 3's
+  // problem over it, each block recorded with its term; evaluated, no
+  // iterations.
+  options.Validate();
+  GivenState given(clip, character, options, cameras, poses, source);
+  const KinematicModel& model = given.model;
+  const Observations& obs = given.obs;
+  Parameters& params = given.params;
+  const FitPriors& priors = given.priors;
+  const ContactWeights contacts =
+      CurrentContacts(obs, model, *clip.layout, options, params);
+  ceres::Problem problem;
+  TermBlocks blocks;
+  BuildProblem(Stage::kPoseWithContacts, obs, model, *clip.layout, options,
+               priors, &contacts, params, problem, &blocks);
+  return EvaluateTerms(problem, blocks, model);
+}
+
+const char* FitTermName(FitTerm term) {
+  switch (term) {
+    case FitTerm::kReprojection:
+      return "reprojection";
+    case FitTerm::kGround:
+      return "ground";
+    case FitTerm::kPenetration:
+      return "penetration";
+    case FitTerm::kUpright:
+      return "upright";
+    case FitTerm::kRootSmooth:
+      return "root smooth";
+    case FitTerm::kTurnSmooth:
+      return "turn smooth";
+    case FitTerm::kPosePrior:
+      return "pose prior";
+    case FitTerm::kPoseSmooth:
+      return "pose smooth";
+    case FitTerm::kFootSlide:
+      return "foot slide";
+    case FitTerm::kBalance:
+      return "balance";
+    case FitTerm::kMeanBalance:
+      return "mean balance";
+    case FitTerm::kFocalPrior:
+      return "focal prior";
+    case FitTerm::kCameraRollPrior:
+      return "camera roll prior";
+    case FitTerm::kCameraHeightPrior:
+      return "camera height prior";
+    case FitTerm::kCameraSpeed:
+      return "camera speed";
+    case FitTerm::kCameraSmooth:
+      return "camera smooth";
+  }
+  return "?";
+}
+
+double FitTermCosts::Total() const {
+  double total = 0.0;
+  for (double c : cost) total += c;
+  return total;
+}
+
+std::string FitTermCosts::BriefReport() const {
+  std::string report;
+  char text[64];
+  for (int i = 0; i < kNumFitTerms; ++i) {
+    if (cost[i] == 0.0) continue;
+    std::snprintf(text, sizeof(text), "%s%s %.3g", report.empty() ? "" : ", ",
+                  FitTermName(static_cast<FitTerm>(i)), cost[i]);
+    report += text;
+  }
+  std::snprintf(text, sizeof(text), "%stotal %.3g", report.empty() ? "" : "; ",
+                Total());
+  return report + text;
 }
 
 ReferenceBundle FitBundle(

@@ -6,6 +6,7 @@
 #ifndef MIMIC2D_FIT_FIT_H_
 #define MIMIC2D_FIT_FIT_H_
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -321,6 +322,52 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
                         const std::vector<PinholeCamera>& cameras,
                         const std::vector<Pose3D>& poses,
                         const std::string& source);
+
+// The objective's terms (docs/fit.md, "Objective"), for a breakdown of its
+// cost.
+enum class FitTerm {
+  kReprojection,
+  kGround,
+  kPenetration,
+  kUpright,
+  kRootSmooth,
+  kTurnSmooth,
+  kPosePrior,  // the learned mixture, or the pull toward rest
+  kPoseSmooth,
+  kFootSlide,
+  kBalance,
+  kMeanBalance,
+  kFocalPrior,
+  kCameraRollPrior,
+  kCameraHeightPrior,
+  kCameraSpeed,
+  kCameraSmooth,
+};
+inline constexpr int kNumFitTerms = 16;
+const char* FitTermName(FitTerm term);
+
+// An objective's cost at one state, term by term (each 1/2 the sum of its
+// squared residuals; their sum is the cost Ceres reports).
+struct FitTermCosts {
+  std::array<double, kNumFitTerms> cost{};
+
+  double& operator[](FitTerm term) { return cost[static_cast<int>(term)]; }
+  double operator[](FitTerm term) const { return cost[static_cast<int>(term)]; }
+  double Total() const;
+  // "reprojection 0.12, ground 0.031, ...; total 0.2": the terms above 0.
+  std::string BriefReport() const;
+};
+
+// Stage 3's objective (the one that settles the camera: the full pose, feet
+// that do not slide at the state's own contacts) at given cameras (1, or one
+// per frame) and poses, term by term, with no iterations. For diagnosis
+// (`mimic2d bench fit --from-truth`): at the truth and at a fit it says which
+// terms prefer the fit. Throws InputError as RefineView does.
+FitTermCosts ExplainCost(const Clip2D& clip, const Character& character,
+                         const FitOptions& options,
+                         const std::vector<PinholeCamera>& cameras,
+                         const std::vector<Pose3D>& poses,
+                         const std::string& source);
 
 // Fits every view of `bundle` independently (as separate videos would be)
 // and returns the bundle with its `estimate` set. `progress` (optional) is

@@ -462,8 +462,12 @@ std::vector<Eigen::Vector3d> SmoothedGroundPath(
   for (int t = 0; t < count; ++t) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int used = 0;
-    for (int s = std::max(0, t - half_window);
-         s <= std::min(count - 1, t + half_window); ++s, ++used) {
+    // Centred: near the ends the window shrinks on both sides, so a subject
+    // moving steadily is followed at its own pace. A window cut on one side
+    // only lags and then stalls (a 0.8-s run under a 1-s window: half speed,
+    // a stop, half speed), which no camera operator does.
+    const int half = std::min({half_window, t, count - 1 - t});
+    for (int s = t - half; s <= t + half; ++s, ++used) {
       sum += poses[s].root_position_m;
     }
     path[t] = sum / used;

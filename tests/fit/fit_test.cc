@@ -828,6 +828,59 @@ TEST(Fit, RefiningFromTheTruthStartsAtIt) {
   }
 }
 
+// The objective term by term (ExplainCost): at the truth of a clean clip
+// the reprojection is near zero (only the hinges clamped into their ranges
+// move keypoints); the same poses under a camera pitched 5 deg down cost
+// reprojection and nothing the camera does not touch. A state that does not
+// match the clip is a named error.
+TEST(Fit, ExplainsTheObjectiveTermByTerm) {
+  auto character = Humanoid();
+  const ReferenceBundle bundle =
+      SyntheticWalk(*character, 1, 1.0, CameraFollow::kStatic);
+  const ReferenceView& view = bundle.views[0];
+  const std::vector<Pose3D>& truth = bundle.ground_truth->poses;
+  FitOptions options;
+  options.fixed_focal_px = view.cameras[0].intrinsics().fx_px;
+  const FitTermCosts at_truth =
+      ExplainCost(view.clip, *character, options, view.cameras, truth, "walk");
+  std::printf("at the truth: %s\n", at_truth.BriefReport().c_str());
+  EXPECT_LT(at_truth[FitTerm::kReprojection], 0.01);
+  EXPECT_GT(at_truth[FitTerm::kPoseSmooth], 0.0);
+  EXPECT_GT(at_truth[FitTerm::kPosePrior], 0.0);
+  double sum = 0.0;
+  for (double c : at_truth.cost) sum += c;
+  EXPECT_DOUBLE_EQ(at_truth.Total(), sum);
+
+  // Pitched about the camera's own x axis (image rows move).
+  std::vector<PinholeCamera> pitched = view.cameras;
+  const double angle_rad = 5.0 * M_PI / 180.0;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitX())
+          .toRotationMatrix() *
+      view.cameras[0].rotation_world_to_camera();
+  pitched[0] = PinholeCamera(view.cameras[0].intrinsics(), rotation,
+                             -(rotation * view.cameras[0].CenterWorld()));
+  const FitTermCosts off =
+      ExplainCost(view.clip, *character, options, pitched, truth, "walk");
+  std::printf("pitched 5 deg: %s\n", off.BriefReport().c_str());
+  EXPECT_GT(off[FitTerm::kReprojection],
+            100.0 * at_truth[FitTerm::kReprojection] + 0.1);
+  for (FitTerm term : {FitTerm::kPoseSmooth, FitTerm::kPosePrior,
+                       FitTerm::kRootSmooth, FitTerm::kTurnSmooth}) {
+    EXPECT_NEAR(off[term], at_truth[term], 1e-6 * (1.0 + at_truth[term]))
+        << FitTermName(term);
+  }
+
+  const std::vector<Pose3D> too_few(truth.begin(), truth.end() - 1);
+  try {
+    ExplainCost(view.clip, *character, options, view.cameras, too_few,
+                "walk.json");
+    ADD_FAILURE() << "a state with a pose missing was accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("walk.json"), std::string::npos);
+  }
+}
+
 // Input the fit cannot use is a named error, never a silent estimate.
 TEST(Fit, RejectsInputItCannotUseWithANamedError) {
   auto character = Humanoid();

@@ -89,6 +89,35 @@ TEST(Bundle, LoopedFollowedWalkStaysInFrame) {
   }
 }
 
+// A following camera keeps pace with a subject moving steadily, to the
+// clip's ends: on a 1-s walk under the 1-s smoothing window it travels as
+// far as the walker and never stalls. (Its window once shrank on one side
+// only: such a clip was followed at half speed, then not at all, then at
+// half speed.)
+TEST(Bundle, AFollowingCameraKeepsPaceToTheClipsEnds) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  WalkFixture walk = LoadWalk(path);
+  BundleFromMotionOptions options;
+  options.duration_s = 1.0;
+  options.rig.num_views = 1;
+  options.follow = CameraFollow::kRootDolly;
+  ReferenceBundle bundle =
+      MakeBundleFromMotion(walk.motion, walk.map, options, "walk");
+  const std::vector<Pose3D>& poses = bundle.ground_truth->poses;
+  const int last = bundle.num_frames() - 1;
+  const double walked_m =
+      (poses[last].root_position_m - poses[0].root_position_m).head<2>().norm();
+  ASSERT_GT(walked_m, 0.5);
+  const ReferenceView& view = bundle.views[0];
+  auto centre = [&](int t) { return view.CameraAt(t).CenterWorld(); };
+  EXPECT_NEAR((centre(last) - centre(0)).head<2>().norm(), walked_m,
+              0.05 * walked_m);
+  for (int t = 0; t < last; ++t) {
+    EXPECT_GT((centre(t + 1) - centre(t)).norm(), 0.5 * walked_m / last)
+        << "frame " << t;
+  }
+}
+
 // Static cameras aimed midway along the path: a walker starts as far
 // before the rig's target as it ends past it.
 TEST(Bundle, AimingAtThePathsMiddleCentresATravellingSubject) {
