@@ -104,6 +104,22 @@ int RunFit(FitArgs& args) {
                                  *truth->ground_truth, *character));
           std::printf("  against the truth: %s\n",
                       accuracies.back().BriefReport().c_str());
+          // Which terms prefer the fit to the truth (docs/fit.md, "Search
+          // or objective?").
+          const std::string source =
+              args.input + " (view " + bundle.views[view].name + ")";
+          std::printf(
+              "  stage 3's terms at the truth: %s\n  stage 3's terms at the "
+              "fit:   %s\n",
+              ExplainCost(bundle.views[view].clip, *character, args.options,
+                          truth->views[view].cameras,
+                          truth->ground_truth->poses, source)
+                  .BriefReport()
+                  .c_str(),
+              ExplainCost(bundle.views[view].clip, *character, args.options,
+                          estimate.cameras, estimate.poses, source)
+                  .BriefReport()
+                  .c_str());
         }
         std::fflush(stdout);
       });
@@ -159,7 +175,8 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
                   "bundle holding the input's 3D truth and true cameras (a "
                   "stripped bundle's original): each view's fit is measured "
                   "against it afterwards (focal, pitch, roll, MPJPE, "
-                  "PA-MPJPE); the fit never reads it");
+                  "PA-MPJPE; stage 3's objective term by term at the truth "
+                  "and at the fit); the fit never reads it");
   fit->callback([run, args] { *run = [args] { return RunFit(*args); }; });
 }
 

@@ -437,8 +437,8 @@ TEST(Cli, DeepOrNonFileInputsAreNamedErrors) {
 }
 
 // `fit --truth`: a stripped walk fitted from its 2D, each view measured
-// afterwards against the original's truth; a truth of another shape is
-// named.
+// afterwards against the original's truth (and the objective explained
+// term by term there and at the fit); a truth of another shape is named.
 TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
   M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
   const std::string dir = testing::TempDir("cli_fit_truth");
@@ -460,6 +460,11 @@ TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
     ++at;
   }
   EXPECT_EQ(measured, 2) << result.output;
+  // With the objective term by term at the truth and at the fit.
+  for (const char* line : {"\n  stage 3's terms at the truth: reprojection ",
+                           "\n  stage 3's terms at the fit:   reprojection "}) {
+    EXPECT_NE(result.output.find(line), std::string::npos) << result.output;
+  }
   // The walk's fit lands within the accuracy table's figures for it.
   const size_t mean = result.output.find("mean over the views");
   ASSERT_NE(mean, std::string::npos) << result.output;
