@@ -477,9 +477,24 @@ std::vector<std::vector<FootIn2d>> ObservedFeet(
             obs.Weight(after, ankle) <= 0) {
           continue;
         }
-        const double step_px =
-            (obs.Pixel(after, ankle) - obs.Pixel(before, ankle)).norm() /
-            (after - before);
+        // A central difference reads the top of a jump's flight as still:
+        // the ankle rises into it and falls out of it alike. Where the two
+        // halves of the span move in opposite directions (a turn, which a
+        // planted foot does not make), the faster half decides.
+        const Eigen::Vector2d span_step =
+            obs.Pixel(after, ankle) - obs.Pixel(before, ankle);
+        double step_px = span_step.norm() / (after - before);
+        if (span_frames > 1 && obs.Weight(t, ankle) > 0 && before < t &&
+            t < after) {
+          const Eigen::Vector2d rise =
+              obs.Pixel(t, ankle) - obs.Pixel(before, ankle);
+          const Eigen::Vector2d fall =
+              obs.Pixel(after, ankle) - obs.Pixel(t, ankle);
+          if (rise.dot(fall) < 0) {
+            step_px =
+                std::max(rise.norm() / (t - before), fall.norm() / (after - t));
+          }
+        }
         feet[t][f] =
             step_px < max_step_px ? FootIn2d::kStill : FootIn2d::kMoving;
         break;

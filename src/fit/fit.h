@@ -141,7 +141,8 @@ struct FitOptions {
   bool contacts_from_2d = true;
   // Static camera: the ground term only in frames where a foot can stand,
   // those where some foot's observed 2D ankle is still (as above) over a
-  // central difference of +-ground_still_span_s, or unseen; where every
+  // central difference of +-ground_still_span_s (the faster half where the
+  // halves turn back, as at a flight's top), or unseen; where every
   // foot is seen moving (a jump's flight) only the penetration term holds
   // the feet. Off: every frame (docs/fit.md, "Ground where a foot is
   // still").

@@ -687,7 +687,8 @@ std::vector<double> LowestPointsM(std::shared_ptr<const Character> character,
 // frames where a 2D ankle is still, the flight leaves the floor and the
 // camera's pitch comes back (docs/fit.md, "Ground where a foot is still").
 // Measured alone (the other static-camera cues off): pitch 18.6 -> 7.7 deg
-// off, the highest fitted lowest sole 0.01 -> 0.18 m. With them on (the
+// off, the highest fitted lowest sole 0.01 -> 0.18 m; 4.6 deg and 0.20 m
+// since the top of the flight no longer reads as still (2026-11-27). With them on (the
 // defaults) this view's pitch is 14.9 -> 13.1 deg off, the flight 0.00 ->
 // 0.18 m: balance on average tilts this one view back.
 TEST(Fit, GroundFromThe2dLetsAJumpLeaveTheFloor) {
@@ -728,7 +729,7 @@ TEST(Fit, GroundFromThe2dLetsAJumpLeaveTheFloor) {
       "%.2f m\n",
       pitch_error_deg(before), pitch_error_deg(after),
       highest_lowest_sole_m(before), highest_lowest_sole_m(after));
-  EXPECT_LT(pitch_error_deg(after), 0.5 * pitch_error_deg(before));
+  EXPECT_LT(pitch_error_deg(after), 0.35 * pitch_error_deg(before));
   EXPECT_GT(highest_lowest_sole_m(after), highest_lowest_sole_m(before) + 0.1);
 }
 
