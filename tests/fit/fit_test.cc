@@ -688,9 +688,9 @@ std::vector<double> LowestPointsM(std::shared_ptr<const Character> character,
 // camera's pitch comes back (docs/fit.md, "Ground where a foot is still").
 // Measured alone (the other static-camera cues off): pitch 18.6 -> 7.7 deg
 // off, the highest fitted lowest sole 0.01 -> 0.18 m; 4.6 deg and 0.20 m
-// since the top of the flight no longer reads as still (2026-11-27). With them on (the
-// defaults) this view's pitch is 14.9 -> 13.1 deg off, the flight 0.00 ->
-// 0.18 m: balance on average tilts this one view back.
+// since the top of the flight no longer reads as still (2026-11-27). With them
+// on (the defaults) this view's pitch is 14.9 -> 13.1 deg off, the flight 0.00
+// -> 0.18 m: balance on average tilts this one view back.
 TEST(Fit, GroundFromThe2dLetsAJumpLeaveTheFloor) {
   auto character = Humanoid();
   const Motion3D motion = ReadDeepMimicMotion(
