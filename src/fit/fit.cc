@@ -1302,10 +1302,12 @@ Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
     const PinholeCamera& at = cameras[std::min<size_t>(c, cameras.size() - 1)];
     params.centres_m.push_back(turn * (at.CenterWorld() - shift));
   }
-  std::vector<double> qpos(character.model()->nq, 0.0);
+  // Along the clip: frame by frame the ball joints' Euler solutions can
+  // switch (docs/fit.md, "Euler switches in the truth").
+  const std::vector<std::vector<double>> rows =
+      PosesToQposAlongClip(character, poses);
   const Eigen::Quaterniond turn_quaternion(turn);
-  for (const Pose3D& pose : poses) {
-    PoseToQpos(character, pose, qpos.data());
+  for (const std::vector<double>& qpos : rows) {
     params.root_m.push_back(
         turn * (Eigen::Vector3d(qpos[0], qpos[1], qpos[2]) - shift));
     const Eigen::Quaterniond root =

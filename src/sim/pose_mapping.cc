@@ -137,6 +137,31 @@ void PoseToQpos(const Character& character, const Pose3D& pose, double* qpos) {
   }
 }
 
+std::vector<std::vector<double>> PosesToQposAlongClip(
+    const Character& character, const std::vector<Pose3D>& poses) {
+  const int nq = character.model()->nq;
+  std::vector<std::vector<double>> rows(poses.size(),
+                                        std::vector<double>(nq, 0.0));
+  for (size_t t = 0; t < poses.size(); ++t) {
+    PoseToQpos(character, poses[t], rows[t].data());
+    if (t == 0) continue;
+    for (int j = 0; j < character.skeleton().num_joints(); ++j) {
+      const BoundJoint& bound = character.joints()[j];
+      if (bound.type != JointType::kSpherical) continue;
+      int address[3];
+      Eigen::Vector3d before;
+      for (int k = 0; k < 3; ++k) {
+        address[k] = character.hinges()[bound.first_hinge + k].qpos_address;
+        before[k] = rows[t - 1][address[k]];
+      }
+      const Eigen::Vector3d nearest =
+          NearestXyzAngles(poses[t].local_rotations[j], before);
+      for (int k = 0; k < 3; ++k) rows[t][address[k]] = nearest[k];
+    }
+  }
+  return rows;
+}
+
 Pose3D QposToPose(const Character& character, const double* qpos) {
   const Skeleton& skeleton = character.skeleton();
   Pose3D pose;

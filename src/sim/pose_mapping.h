@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "motion/motion3d.h"
 #include "sim/character.h"
@@ -23,6 +24,17 @@ Eigen::Quaterniond FromIntrinsicXyzAngles(const Eigen::Vector3d& angles);
 // take whichever of the two Euler solutions fits the hinge ranges better.
 // Other entries (e.g. a ball's) are left untouched.
 void PoseToQpos(const Character& character, const Pose3D& pose, double* qpos);
+
+// `poses` (a clip) as qpos rows, each ball joint's angles continuing the
+// previous frame's: the first frame as PoseToQpos, then each joint's Euler
+// solution nearest (angle by angle, modulo 2 pi) the one before it. Chosen
+// frame by frame, PoseToQpos switches between the two solutions where
+// their fit to the ranges crosses over, a jump of about pi in three angles
+// that no motion makes (11 such steps in the DeepMimic kick; docs/fit.md,
+// "Euler switches in the truth"). Continuity comes first: an angle that
+// turns past +-pi keeps going instead of wrapping.
+std::vector<std::vector<double>> PosesToQposAlongClip(
+    const Character& character, const std::vector<Pose3D>& poses);
 
 // The character's pose in `qpos` (fixed joints get identity rotations).
 Pose3D QposToPose(const Character& character, const double* qpos);

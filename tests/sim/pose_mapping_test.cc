@@ -171,6 +171,56 @@ TEST(PoseMappingTest, DeepMimicWalkSitesMatchSkeletonKeypointsWithin1mm) {
               motion.num_frames(), worst);
 }
 
+// Converted frame by frame, the kick's and the dance's ball joints switch
+// between their two Euler solutions (steps of 3.10 and 3.15 rad with no
+// motion); along the clip they do not (at most 1.21 and 0.44 rad), and
+// every frame keeps its rotations.
+TEST(PoseMappingTest, AlongAClipBallJointsKeepTheirEulerSolution) {
+  auto character = LoadHumanoid("flat");
+  const int nq = character->model()->nq;
+  for (const char* clip : {"kick", "dance_a"}) {
+    M2D_REQUIRE_SHARED(
+        path, std::string("deepmimic/motions/humanoid3d_") + clip + ".txt");
+    const Motion3D motion =
+        ReadDeepMimicMotion(path, character->shared_skeleton());
+    // The largest step of any hinge between frames (rad).
+    auto largest_step = [&](const std::vector<std::vector<double>>& rows) {
+      double largest = 0.0;
+      for (size_t t = 1; t < rows.size(); ++t) {
+        for (const ActuatedHinge& hinge : character->hinges()) {
+          largest =
+              std::max(largest, std::abs(rows[t][hinge.qpos_address] -
+                                         rows[t - 1][hinge.qpos_address]));
+        }
+      }
+      return largest;
+    };
+    std::vector<std::vector<double>> per_frame(motion.num_frames(),
+                                               std::vector<double>(nq, 0.0));
+    for (int t = 0; t < motion.num_frames(); ++t)
+      PoseToQpos(*character, motion.frames[t], per_frame[t].data());
+    const std::vector<std::vector<double>> along =
+        PosesToQposAlongClip(*character, motion.frames);
+    std::printf(
+        "%s: largest hinge step %.2f rad frame by frame, %.2f along "
+        "the clip\n",
+        clip, largest_step(per_frame), largest_step(along));
+    EXPECT_GT(largest_step(per_frame), 2.0) << clip;
+    EXPECT_LT(largest_step(along), 1.5) << clip;  // measured 1.21, 0.44
+    ASSERT_EQ(along.size(), motion.frames.size());
+    for (int t = 0; t < motion.num_frames(); ++t) {
+      const Pose3D back = QposToPose(*character, along[t].data());
+      for (size_t j = 0; j < back.local_rotations.size(); ++j) {
+        ASSERT_LT(RotationDistance(back.local_rotations[j],
+                                   motion.frames[t].local_rotations[j]),
+                  1e-9)
+            << clip << " frame " << t << " joint "
+            << character->skeleton().joints[j].name;
+      }
+    }
+  }
+}
+
 // qvel from two poses, integrated by MuJoCo over dt, reaches the second
 // pose: the root's angular velocity is in the root frame as MuJoCo expects.
 TEST(PoseMappingTest, FiniteDifferenceQvelIntegratesToTheNextPose) {
