@@ -1183,13 +1183,6 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
       " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best) +
       Seconds(pose.seconds));
 
-  // The contacts of the current estimate, gated by the feet standing
-  // still: seen in the 2D (static camera, contacts_from_2d) or by the
-  // fitted feet's speed.
-  auto current_contacts = [&]() {
-    return CurrentContacts(obs, model, layout, options, best);
-  };
-
   // Stage 3: feet that do not slide, at the contacts the previous solve
   // found; relabelled and solved again, since better contacts move the root
   // and the root's motion sharpens the contacts.
@@ -1206,7 +1199,8 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
             EstimateContacts(points, model, options, obs.fps, pass > 0), best);
       }
     }
-    const ContactWeights contacts = current_contacts();
+    const ContactWeights contacts =
+        CurrentContacts(obs, model, layout, options, best);
     final_stage =
         SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
                    model, layout, options, priors, &contacts, best);
@@ -1220,7 +1214,8 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   // Stage 4: the pose refined toward the 2D under the camera held, with
   // weaker smoothness and prior (SMPLify's falling weights, one step more).
   if (options.refine_iterations > 0) {
-    const ContactWeights contacts = current_contacts();
+    const ContactWeights contacts =
+        CurrentContacts(obs, model, layout, options, best);
     final_stage = SolveStage(Stage::kRefine, options.refine_iterations, obs,
                              model, layout, options, priors, &contacts, best);
     summary.iterations += final_stage.iterations;
