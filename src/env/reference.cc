@@ -169,7 +169,7 @@ void QvelAtFrame(const Character& character, const std::vector<Pose3D>& poses,
   std::fill(qvel->begin(), qvel->end(), 0.0);
   if (next > previous) {
     QvelFromPoses(character, poses[previous], poses[next],
-                  (next - previous) * dt_s, qvel->data());
+                  (next - previous) * dt_s, qvel->data(), &poses[t]);
   }
 }
 
@@ -181,6 +181,11 @@ void SetEstimatedPose(const std::vector<Pose3D>& poses, int t, double dt_s,
   QvelAtFrame(simulation.character(), poses, t, dt_s, qvel);
   simulation.SetPose(poses[t], qvel->data());
   RaiseCharacter(std::max(0.0, -LowestCharacterPointZ(simulation)), simulation);
+}
+
+// A rotation from MuJoCo's (w, x, y, z) quaternion layout.
+Eigen::Quaterniond MujocoRotation(const double* wxyz) {
+  return Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
 }
 
 }  // namespace
@@ -294,18 +299,30 @@ void ReadBodyTarget(const Simulation& simulation, const double* keypoints_xyz,
   const double* root_qpos = data->qpos + character.root_qpos_address();
   const double* root_qvel = data->qvel + character.root_dof_address();
   target->root_position_m = {root_qpos[0], root_qpos[1], root_qpos[2]};
-  target->root_orientation =
-      Eigen::Quaterniond(root_qpos[3], root_qpos[4], root_qpos[5], root_qpos[6])
-          .normalized();
+  target->root_orientation = MujocoRotation(root_qpos + 3);
   target->root_linear_velocity_m_s = {root_qvel[0], root_qvel[1], root_qvel[2]};
   target->root_angular_velocity_rad_s = {root_qvel[3], root_qvel[4],
                                          root_qvel[5]};
-  const std::vector<ActuatedHinge>& hinges = character.hinges();
-  target->hinge_angles_rad.resize(hinges.size());
-  target->hinge_velocities_rad_s.resize(hinges.size());
-  for (size_t j = 0; j < hinges.size(); ++j) {
-    target->hinge_angles_rad[j] = data->qpos[hinges[j].qpos_address];
-    target->hinge_velocities_rad_s[j] = data->qvel[hinges[j].dof_address];
+  // Each moving joint from its body and the parent's: rotation q_p^-1 q_c
+  // (xquat), angular velocity R_p^T (w_c - w_p) (cvel's rotational part is
+  // in world axes). Both are current after mj_step1 / Refresh.
+  const int* parent_of = simulation.model()->body_parentid;
+  target->joint_rotations.clear();
+  target->joint_angular_velocities_rad_s.clear();
+  for (const BoundJoint& joint : character.joints()) {
+    if (joint.type != JointType::kSpherical &&
+        joint.type != JointType::kRevolute) {
+      continue;
+    }
+    const int body = joint.body_id, parent = parent_of[joint.body_id];
+    const Eigen::Quaterniond parent_rotation =
+        MujocoRotation(data->xquat + 4 * parent);
+    target->joint_rotations.push_back(parent_rotation.conjugate() *
+                                      MujocoRotation(data->xquat + 4 * body));
+    const Eigen::Map<const Eigen::Vector3d> child_w(data->cvel + 6 * body);
+    const Eigen::Map<const Eigen::Vector3d> parent_w(data->cvel + 6 * parent);
+    target->joint_angular_velocities_rad_s.push_back(
+        parent_rotation.conjugate() * (child_w - parent_w));
   }
   const int num_keypoints = character.keypoint_layout().num_keypoints();
   target->keypoints_m.resize(num_keypoints);

@@ -83,13 +83,13 @@ bool ShouldExitEarly(const ReprojectionError& error, double max_error_px) {
 Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,
                                   const BodyTarget3D& reference) {
   Tracking3DError error;
-  for (size_t j = 0; j < reference.hinge_angles_rad.size(); ++j) {
-    const double angle =
-        simulated.hinge_angles_rad[j] - reference.hinge_angles_rad[j];
-    const double velocity = simulated.hinge_velocities_rad_s[j] -
-                            reference.hinge_velocities_rad_s[j];
-    error.hinge_sq_rad2 += angle * angle;
-    error.hinge_velocity_sq += velocity * velocity;
+  for (size_t j = 0; j < reference.joint_rotations.size(); ++j) {
+    const double angle = simulated.joint_rotations[j].angularDistance(
+        reference.joint_rotations[j]);
+    error.joint_rotation_sq_rad2 += angle * angle;
+    error.joint_velocity_sq += (simulated.joint_angular_velocities_rad_s[j] -
+                                reference.joint_angular_velocities_rad_s[j])
+                                   .squaredNorm();
   }
   error.root_position_sq_m2 =
       (simulated.root_position_m - reference.root_position_m).squaredNorm();
@@ -128,9 +128,9 @@ RewardTerms ComputeReward3D(const Tracking3DError& error, double abs_power_w,
   RewardTerms terms;
   terms.pose =
       weights.pose_weight *
-          std::exp(-weights.pose_scale * error.hinge_sq_rad2) +
+          std::exp(-weights.pose_scale * error.joint_rotation_sq_rad2) +
       weights.velocity_weight *
-          std::exp(-weights.velocity_scale * error.hinge_velocity_sq) +
+          std::exp(-weights.velocity_scale * error.joint_velocity_sq) +
       weights.root_weight *
           std::exp(-weights.root_scale * (error.root_position_sq_m2 +
                                           0.1 * error.root_rotation_sq_rad2)) +

@@ -86,26 +86,37 @@ bool ShouldExitEarly(const ReprojectionError& error, double max_error_px);
 
 // The character's state at one frame, as 3D tracking compares it: root
 // pose and velocity (MuJoCo's free joint: linear velocity in the world,
-// angular in the root's frame), hinge angles and velocities, keypoints.
+// angular in the root's frame), each moving joint's rotation and angular
+// velocity, keypoints.
+//
+// Joints are compared as rotations, not hinge angles: a ball joint's three
+// hinges reach most rotations by two Euler solutions, and a reference
+// converted frame by frame switches between them where nothing moves
+// (kick, dance_a, spin), while a simulated episode keeps the solution it
+// started in. Rotations and angular velocities do not depend on the solution.
 struct BodyTarget3D {
   Eigen::Vector3d root_position_m = Eigen::Vector3d::Zero();
   Eigen::Quaterniond root_orientation = Eigen::Quaterniond::Identity();
   Eigen::Vector3d root_linear_velocity_m_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d root_angular_velocity_rad_s = Eigen::Vector3d::Zero();
-  std::vector<double> hinge_angles_rad, hinge_velocities_rad_s;
+  // Per moving (ball or revolute) joint, in skeleton order: its body's
+  // rotation relative to the parent body, and its angular velocity relative
+  // to the parent's, in the parent's frame (rad/s).
+  std::vector<Eigen::Quaterniond> joint_rotations;
+  std::vector<Eigen::Vector3d> joint_angular_velocities_rad_s;
   std::vector<Eigen::Vector3d> keypoints_m;
 };
 
 // How far a simulated state is from its 3D reference frame.
 struct Tracking3DError {
-  double hinge_sq_rad2 = 0.0;          // sum_j (q_j - q^_j)^2
-  double hinge_velocity_sq = 0.0;      // sum_j (qdot_j - qdot^_j)^2
-  double root_position_sq_m2 = 0.0;    // |p - p^|^2 (world)
-  double root_rotation_sq_rad2 = 0.0;  // angle(R, R^)^2
-  double root_velocity_sq = 0.0;       // |v - v^|^2 + 0.1 |w - w^|^2
-  double keypoint_local_sq_m2 = 0.0;   // sum_k |(x_k - p) - (x^_k - p^)|^2
-  double max_keypoint_m = 0.0;         // worst |x_k - x^_k| (world)
-  double mean_keypoint_m = 0.0;        // mean |x_k - x^_k| (world)
+  double joint_rotation_sq_rad2 = 0.0;  // sum_j angle(R_j, R^_j)^2
+  double joint_velocity_sq = 0.0;       // sum_j |w_j - w^_j|^2 ((rad/s)^2)
+  double root_position_sq_m2 = 0.0;     // |p - p^|^2 (world)
+  double root_rotation_sq_rad2 = 0.0;   // angle(R, R^)^2
+  double root_velocity_sq = 0.0;        // |v - v^|^2 + 0.1 |w - w^|^2
+  double keypoint_local_sq_m2 = 0.0;    // sum_k |(x_k - p) - (x^_k - p^)|^2
+  double max_keypoint_m = 0.0;          // worst |x_k - x^_k| (world)
+  double mean_keypoint_m = 0.0;         // mean |x_k - x^_k| (world)
 };
 
 // Compares two states of the same character (sizes must agree).
@@ -113,10 +124,9 @@ Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,
                                   const BodyTarget3D& reference);
 
 // DeepMimic-style terms, with MimicKit's weights and scales as defaults
-// (../shared/notes/reference-settings.md); hinge angles stand in for
-// DeepMimic's joint quaternions.
+// (../shared/notes/reference-settings.md).
 struct Body3DRewardWeights {
-  double pose_weight = 0.5;             // on exp(-pose_scale * hinge_sq)
+  double pose_weight = 0.5;             // on exp(-pose_scale * rotation_sq)
   double pose_scale = 2.0;              // 1/rad^2
   double velocity_weight = 0.1;         // on exp(-velocity_scale * vel_sq)
   double velocity_scale = 0.1;          // 1/(rad/s)^2
@@ -132,11 +142,12 @@ struct Body3DRewardWeights {
   template <typename Self, typename Visitor>
   static void VisitFields(Self& self, Visitor& v) {
     v("pose_weight", self.pose_weight, Range::AtLeast(0),
-      "weight of exp(-pose_scale * sum of squared hinge-angle errors)");
+      "weight of exp(-pose_scale * sum of squared joint-rotation angles "
+      "between the character and its reference)");
     v("pose_scale", self.pose_scale, Range::AtLeast(0), "1/rad^2");
     v("velocity_weight", self.velocity_weight, Range::AtLeast(0),
-      "weight of exp(-velocity_scale * sum of squared hinge-velocity "
-      "errors)");
+      "weight of exp(-velocity_scale * sum of squared joint angular-"
+      "velocity errors)");
     v("velocity_scale", self.velocity_scale, Range::AtLeast(0), "1/(rad/s)^2");
     v("root_weight", self.root_weight, Range::AtLeast(0),
       "weight of exp(-root_scale * (root position error^2 + 0.1 root "

@@ -63,6 +63,36 @@ Eigen::Vector3d NearestXyzAngles(const Eigen::Quaterniond& rotation,
   return best;
 }
 
+// The angular velocity (in the parent's axes) that turns `from` into `to`
+// in `dt_s`: to = exp(dt [w]x) from.
+Eigen::Vector3d ParentAxesAngularVelocity(const Eigen::Quaterniond& from,
+                                          const Eigen::Quaterniond& to,
+                                          double dt_s) {
+  Eigen::Quaterniond delta = to.normalized() * from.normalized().conjugate();
+  if (delta.w() < 0) delta.coeffs() *= -1.0;
+  const Eigen::AngleAxisd turn(delta);
+  return turn.axis() * (turn.angle() / dt_s);
+}
+
+// The rates of intrinsic XYZ angles (a, b, c) that turn at `omega` (parent
+// axes): omega = J rates, J's columns x, Rx(a) y, Rx(a) Ry(b) z. det J =
+// cos b: near gimbal lock the rates of a and c alone are undefined, and a
+// small damping keeps them finite (at most ~1/(2 * 0.01) x |omega|).
+Eigen::Vector3d XyzRatesFor(const Eigen::Vector3d& angles,
+                            const Eigen::Vector3d& omega) {
+  const Eigen::AngleAxisd about_x(angles[0], Eigen::Vector3d::UnitX());
+  Eigen::Matrix3d jacobian;
+  jacobian.col(0) = Eigen::Vector3d::UnitX();
+  jacobian.col(1) = about_x * Eigen::Vector3d::UnitY();
+  jacobian.col(2) =
+      about_x * (Eigen::AngleAxisd(angles[1], Eigen::Vector3d::UnitY()) *
+                 Eigen::Vector3d::UnitZ());
+  constexpr double kDamping2 = 1e-4;  // 0.01^2
+  const Eigen::Matrix3d normal =
+      jacobian.transpose() * jacobian + kDamping2 * Eigen::Matrix3d::Identity();
+  return normal.ldlt().solve(jacobian.transpose() * omega);
+}
+
 // Signed angle of a rotation about a unit axis (its twist), in (-pi, pi].
 double AngleAbout(const Eigen::Quaterniond& rotation,
                   const Eigen::Vector3d& axis) {
@@ -192,9 +222,11 @@ Pose3D QposToPose(const Character& character, const double* qpos) {
 }
 
 void QvelFromPoses(const Character& character, const Pose3D& from,
-                   const Pose3D& to, double dt_s, double* qvel) {
+                   const Pose3D& to, double dt_s, double* qvel,
+                   const Pose3D* at) {
   CheckPoseSize(character, from);
   CheckPoseSize(character, to);
+  if (at) CheckPoseSize(character, *at);
   if (!(dt_s > 0.0)) throw InputError("", "QvelFromPoses needs dt_s > 0");
   const Skeleton& skeleton = character.skeleton();
   for (int j = 0; j < skeleton.num_joints(); ++j) {
@@ -215,13 +247,20 @@ void QvelFromPoses(const Character& character, const Pose3D& from,
         root[3 + k] = angular[k];
       }
     } else if (bound.type == JointType::kSpherical) {
-      const Eigen::Vector3d start = SphericalAngles(
-          character, bound.first_hinge, from.local_rotations[j]);
-      const Eigen::Vector3d end =
-          NearestXyzAngles(to.local_rotations[j], start);
+      Eigen::Vector3d rates;
+      if (at) {
+        const Eigen::Vector3d angles = SphericalAngles(
+            character, bound.first_hinge, at->local_rotations[j]);
+        rates = XyzRatesFor(
+            angles, ParentAxesAngularVelocity(from.local_rotations[j],
+                                              to.local_rotations[j], dt_s));
+      } else {
+        const Eigen::Vector3d start = SphericalAngles(
+            character, bound.first_hinge, from.local_rotations[j]);
+        rates = (NearestXyzAngles(to.local_rotations[j], start) - start) / dt_s;
+      }
       for (int k = 0; k < 3; ++k) {
-        qvel[character.hinges()[bound.first_hinge + k].dof_address] =
-            (end[k] - start[k]) / dt_s;
+        qvel[character.hinges()[bound.first_hinge + k].dof_address] = rates[k];
       }
     } else if (bound.type == JointType::kRevolute) {
       const Eigen::Vector3d& axis = skeleton.joints[j].axis;

@@ -43,9 +43,15 @@ Pose3D QposToPose(const Character& character, const double* qpos);
 // `from` to `to` in `dt_s` by finite differences: root linear velocity
 // (world frame) and angular velocity (root frame, as MuJoCo's freejoint
 // expects), and hinge rates. Euler angles of `to` are taken on the branch
-// nearest those of `from`, so the rates stay continuous.
+// nearest those of `from`, so the rates stay continuous (and the hinges,
+// integrated, reach `to` exactly). With `at` (the pose the velocity is set
+// with, e.g. the middle of a central difference), a ball joint's rates are
+// instead those of the Euler solution PoseToQpos picks for `at` that turn it
+// at the angular velocity from `from` to `to`: right whichever solution
+// `from` and `to` would pick, and not thrown off near gimbal lock.
 void QvelFromPoses(const Character& character, const Pose3D& from,
-                   const Pose3D& to, double dt_s, double* qvel);
+                   const Pose3D& to, double dt_s, double* qvel,
+                   const Pose3D* at = nullptr);
 
 }  // namespace m2d
 

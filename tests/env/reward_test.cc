@@ -107,17 +107,19 @@ TEST(Reprojection, ViewsCombineWorstOfMaxAndMeanOfMeans) {
   EXPECT_EQ(single.num_present, 17);
 }
 
-BodyTarget3D TwoHingeBody() {
+BodyTarget3D TwoJointBody() {
   BodyTarget3D body;
   body.root_position_m = {1, 2, 0.9};
-  body.hinge_angles_rad = {0.1, -0.2};
-  body.hinge_velocities_rad_s = {1.0, 0.5};
+  body.joint_rotations = {
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX())),
+      Eigen::Quaterniond(Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()))};
+  body.joint_angular_velocities_rad_s = {{1.0, 0, 0}, {0, 0.5, 0}};
   body.keypoints_m = {{1, 2, 1.6}, {1.2, 2, 0.1}};
   return body;
 }
 
 TEST(Tracking3D, AStateOnItsReferenceEarnsEveryWeight) {
-  const BodyTarget3D body = TwoHingeBody();
+  const BodyTarget3D body = TwoJointBody();
   Tracking3DError error = MeasureTracking3D(body, body);
   EXPECT_DOUBLE_EQ(error.max_keypoint_m, 0.0);
   Body3DRewardWeights weights;
@@ -126,16 +128,28 @@ TEST(Tracking3D, AStateOnItsReferenceEarnsEveryWeight) {
 }
 
 TEST(Tracking3D, EachErrorLowersItsTermAsDeepMimicsExponentials) {
-  const BodyTarget3D reference = TwoHingeBody();
+  const BodyTarget3D reference = TwoJointBody();
   Body3DRewardWeights weights;
-  // Hinge angles 0.3 rad off in both: the pose term is 0.5 exp(-2 * 0.18).
+  // Both joints turned 0.3 rad further, about any axis: the pose term is
+  // 0.5 exp(-2 * 0.18).
   BodyTarget3D bent = reference;
-  bent.hinge_angles_rad[0] += 0.3;
-  bent.hinge_angles_rad[1] -= 0.3;
+  bent.joint_rotations[0] =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0, 0.6, 0.8)) *
+      bent.joint_rotations[0];
+  bent.joint_rotations[1] = bent.joint_rotations[1] *
+                            Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitZ());
   Tracking3DError error = MeasureTracking3D(bent, reference);
-  EXPECT_NEAR(error.hinge_sq_rad2, 0.18, 1e-12);
+  EXPECT_NEAR(error.joint_rotation_sq_rad2, 0.18, 1e-12);
   EXPECT_NEAR(ComputeReward3D(error, 0.0, weights, 0.0).total,
               0.5 * std::exp(-0.36) + 0.5, 1e-12);
+  // One joint spinning 2 rad/s faster: the velocity term is
+  // 0.1 exp(-0.1 * 4).
+  BodyTarget3D spun = reference;
+  spun.joint_angular_velocities_rad_s[1].z() += 2.0;
+  error = MeasureTracking3D(spun, reference);
+  EXPECT_NEAR(error.joint_velocity_sq, 4.0, 1e-12);
+  EXPECT_NEAR(ComputeReward3D(error, 0.0, weights, 0.0).total,
+              0.9 + 0.1 * std::exp(-0.4), 1e-12);
   // The whole body 0.2 m to the side: the root term drops, the
   // root-relative keypoint term does not, the worst keypoint is 0.2 m off.
   BodyTarget3D moved = reference;
