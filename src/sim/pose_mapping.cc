@@ -63,15 +63,21 @@ Eigen::Vector3d NearestXyzAngles(const Eigen::Quaterniond& rotation,
   return best;
 }
 
+// The constant angular velocity that makes the turn `delta` in `dt_s`, the
+// short way round: its rotation vector divided by the time.
+Eigen::Vector3d AngularVelocityOfTurn(Eigen::Quaterniond delta, double dt_s) {
+  if (delta.w() < 0) delta.coeffs() *= -1.0;
+  const Eigen::AngleAxisd turn(delta);
+  return turn.axis() * (turn.angle() / dt_s);
+}
+
 // The angular velocity (in the parent's axes) that turns `from` into `to`
 // in `dt_s`: to = exp(dt [w]x) from.
 Eigen::Vector3d ParentAxesAngularVelocity(const Eigen::Quaterniond& from,
                                           const Eigen::Quaterniond& to,
                                           double dt_s) {
-  Eigen::Quaterniond delta = to.normalized() * from.normalized().conjugate();
-  if (delta.w() < 0) delta.coeffs() *= -1.0;
-  const Eigen::AngleAxisd turn(delta);
-  return turn.axis() * (turn.angle() / dt_s);
+  return AngularVelocityOfTurn(to.normalized() * from.normalized().conjugate(),
+                               dt_s);
 }
 
 // The rates of intrinsic XYZ angles (a, b, c) that turn at `omega` (parent
@@ -236,12 +242,10 @@ void QvelFromPoses(const Character& character, const Pose3D& from,
       const Eigen::Vector3d linear =
           (to.root_position_m - from.root_position_m) / dt_s;
       // Body-frame angular velocity: q_to = q_from * exp(omega dt / 2).
-      Eigen::Quaterniond delta =
+      const Eigen::Vector3d angular = AngularVelocityOfTurn(
           from.local_rotations[j].normalized().conjugate() *
-          to.local_rotations[j].normalized();
-      if (delta.w() < 0) delta.coeffs() *= -1.0;
-      const Eigen::AngleAxisd turn(delta);
-      const Eigen::Vector3d angular = turn.axis() * (turn.angle() / dt_s);
+              to.local_rotations[j].normalized(),
+          dt_s);
       for (int k = 0; k < 3; ++k) {
         root[k] = linear[k];
         root[3 + k] = angular[k];
