@@ -6,7 +6,9 @@
 #   docs/experiments/walk2d_fast/eval_curve.sh runs/exp/I substeps2_seed1 >> docs/experiments/walk2d_fast/eval_curves.csv
 set -e
 dir=$1; variant=$2
-for c in $(ls "$dir"/ckpt_*.pt | sort -t_ -k2 -n); do
+# In order of samples (sorted on the file name alone: the folder may hold _).
+for name in $(cd "$dir" && printf '%s\n' ckpt_*.pt | sort -t_ -k2 -n); do
+  c="$dir/$name"
   n=$(basename "$c" .pt | cut -d_ -f2)
   j="$dir/eval_$n.json"
   [ -f "$j" ] || build/mimic2d eval "$c" --bundle runs/walk_fitted.json \
