@@ -23,9 +23,11 @@ snapshot() {  # copies checkpoint.pt if it changed since the last copy
   local stamp samples
   stamp=$(stat -c %Y "$dir/checkpoint.pt")
   [ "$stamp" != "$last" ] || return 0
-  sleep 2  # the log row of the checkpoint's iteration is written with it
-  samples=$(tail -n 1 "$dir/train_log.csv" | cut -d, -f2)
-  cp "$dir/checkpoint.pt" "$dir/ckpt_$samples.pt"
+  # Named by the samples the checkpoint holds (the log runs on meanwhile).
+  cp "$dir/checkpoint.pt" "$dir/snapshot.pt"
+  samples=$(/tmp/timed_run_mimic2d checkpoint info "$dir/snapshot.pt" |
+    sed -n 's/.*trained: \([0-9]*\) samples.*/\1/p')
+  mv "$dir/snapshot.pt" "$dir/ckpt_$samples.pt"
   last=$stamp
 }
 while kill -0 "$trainer" 2>/dev/null; do
