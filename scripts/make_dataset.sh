@@ -48,6 +48,13 @@ make_one() {  # clip index [noisy]
   local elevation=0 elevation_span=30
   if (( index % 2 )); then elevation=30; elevation_span=-30; fi
   local azimuth=$(( (index * 37) % 360 ))
+  # Done: fitted, or refused by an earlier fit (its log ends in an error).
+  # A fit stopped part-way left neither, and is made again.
+  [ -f "$out/${name}.json" ] && return 0
+  if grep -q '^error' "$out/${name}_fit.log" 2>/dev/null; then
+    echo "left out $name (as before): $(grep -m 1 '^error' "$out/${name}_fit.log")"
+    return 0
+  fi
   if [ ! -f "$out/${name}_2d.json" ]; then
     $bin clip from-motion "$motion" --views 4 --first-azimuth "$azimuth" \
       --elevation "$elevation" --elevation-span "$elevation_span" \
@@ -55,14 +62,14 @@ make_one() {  # clip index [noisy]
       "${noise[@]}" -o "$out/${name}_truth.json" > /dev/null
     $bin clip strip "$out/${name}_truth.json" -o "$out/${name}_2d.json" \
       > /dev/null
-    if $bin fit "$out/${name}_2d.json" --camera static --focal 1400 --quiet \
-      "${fit_config[@]}" --truth "$out/${name}_truth.json" \
-      -o "$out/${name}.json" > "$out/${name}_fit.log" 2>&1; then
-      echo "fitted $name"
-    else
-      echo "left out $name: $(grep -m 1 '^error' "$out/${name}_fit.log" ||
-        tail -n 1 "$out/${name}_fit.log")"
-    fi
+  fi
+  if $bin fit "$out/${name}_2d.json" --camera static --focal 1400 --quiet \
+    "${fit_config[@]}" --truth "$out/${name}_truth.json" \
+    -o "$out/${name}.json" > "$out/${name}_fit.log" 2>&1; then
+    echo "fitted $name"
+  else
+    echo "left out $name: $(grep -m 1 '^error' "$out/${name}_fit.log" ||
+      tail -n 1 "$out/${name}_fit.log")"
   fi
 }
 

@@ -22,6 +22,7 @@ struct TrainArgs {
   int max_iterations = 0;
   std::string run_dir;
   int64_t total_samples = 0;
+  bool keep_checkpoints = false;
   bool list_settings = false;
 };
 
@@ -44,6 +45,7 @@ int RunTrain(const TrainArgs& args) {
   TrainConfig config = LoadTrainConfig(args.config_path);
   if (!args.run_dir.empty()) config.run.run_dir = args.run_dir;
   if (args.total_samples > 0) config.run.total_samples = args.total_samples;
+  if (args.keep_checkpoints) config.run.keep_checkpoints = true;
   std::printf(
       "training %s -> %s (%d envs x %d steps per iteration, %lld samples)\n",
       args.config_path.c_str(), config.run.run_dir.c_str(), config.ppo.num_envs,
@@ -101,6 +103,9 @@ void AddTrainCommand(CLI::App& app, CommandRun* run) {
   train->add_option("--run-dir", args->run_dir, "Override run.run_dir");
   train->add_option("--total-samples", args->total_samples,
                     "Override run.total_samples");
+  train->add_flag("--keep-checkpoints", args->keep_checkpoints,
+                  "Set run.keep_checkpoints: also keep every checkpoint as "
+                  "<run_dir>/checkpoints/ckpt_<samples>.pt");
   train->callback([run, args] { *run = [args] { return RunTrain(*args); }; });
 }
 

@@ -249,6 +249,10 @@ struct RunOptions {
   int64_t total_samples = 20'000'000;  // stop after this many env steps
   double checkpoint_minutes = 5.0;     // periodic atomic checkpoint
   int env_threads = 2;                 // OpenMP threads stepping envs
+  // Also keep every checkpoint as checkpoints/ckpt_<samples>.pt: the
+  // learning curve of a run is then measured afterwards by evaluating
+  // them (32 MB each for the dataset's networks, every checkpoint_minutes).
+  bool keep_checkpoints = false;
   // A fresh run's networks (and observation normalizer) start from this
   // checkpoint's: fine-tuning a trained policy on new references. Empty:
   // random weights. Ignored when resuming the run's own checkpoint.
@@ -264,6 +268,9 @@ struct RunOptions {
       "stop after this many environment steps");
     v("checkpoint_minutes", self.checkpoint_minutes, Range::Above(0),
       "period of the atomic checkpoint (minutes)");
+    v("keep_checkpoints", self.keep_checkpoints, Range::Any(),
+      "also keep every checkpoint as checkpoints/ckpt_<samples>.pt in the "
+      "run folder (for learning curves)");
     v("env_threads", self.env_threads, Range::Closed(1, 1024),
       "OpenMP threads stepping environments");
     v("init_from", self.init_from, Range::Any(),

@@ -89,6 +89,14 @@ struct Trainer::State {
   void Save() {
     m2d::SaveCheckpoint(checkpoint_path, config, model, *optimizer, counters,
                         initial_states.get(), state_template);
+    if (config.run.keep_checkpoints) {
+      // A copy named by what it holds, written atomically as well.
+      const std::string kept_dir = config.run.run_dir + "/checkpoints";
+      std::filesystem::create_directories(kept_dir);
+      WriteFileAtomic(
+          kept_dir + "/ckpt_" + std::to_string(counters.samples) + ".pt",
+          ReadFileText(checkpoint_path));
+    }
   }
   // A fixed sigma is a setting, not learned state: after loading weights the
   // config decides it (e.g. less exploration later in a long run).

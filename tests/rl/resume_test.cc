@@ -181,6 +181,36 @@ TEST(Resume, WithoutACheckpointStartsFresh) {
   fs::remove_all(dir);
 }
 
+TEST(Resume, KeptCheckpointsAreNamedByTheSamplesTheyHold) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("resume_kept");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.run.keep_checkpoints = true;
+  config.run.checkpoint_minutes = 1e-6;  // a checkpoint every iteration
+  TrainIterations(config, /*resume=*/false, 2);
+  TrainIterations(config, /*resume=*/true, 1);
+
+  // One copy per iteration (the final save of a run has the same name as
+  // its last periodic one), each loading to the counters its name says.
+  const std::string kept = config.run.run_dir + "/checkpoints";
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(kept))
+    names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names, (std::vector<std::string>{"ckpt_128.pt", "ckpt_192.pt",
+                                             "ckpt_64.pt"}));
+  for (int i = 1; i <= 3; ++i) {
+    CheckpointCounters counters =
+        ReadCounters(kept + "/ckpt_" + std::to_string(i * kBatch) + ".pt");
+    EXPECT_EQ(counters.iteration, i);
+    EXPECT_EQ(counters.samples, i * kBatch);
+  }
+  // The last copy is the run's checkpoint, byte for byte.
+  EXPECT_EQ(ReadFileText(kept + "/ckpt_192.pt"),
+            ReadFileText(config.run.run_dir + "/checkpoint.pt"));
+  fs::remove_all(dir);
+}
+
 TEST(Resume, DropsLogRowsPastTheCheckpoint) {
   M2D_REQUIRE_SHARED(walk_path, kWalk);
   const std::string dir = testing::TempDir("resume_trim");

@@ -1,14 +1,16 @@
 #!/bin/bash
-# Evaluates every ckpt_<samples>.pt of a run folder (copied while training,
-# e.g. by a loop that copies checkpoint.pt each time it changes) with 10
+# Evaluates every ckpt_<samples>.pt of a run folder (kept while training by
+# `train --keep-checkpoints` in RUN/checkpoints/, or in RUN itself) with 10
 # episodes x 10 s per view from the fit's starts and cameras, and prints
 # eval_curves.csv rows: variant,samples,wall_time_s,succ,e2d_px,mean_frames.
 #   docs/experiments/walk2d_fast/eval_curve.sh runs/exp/I substeps2_seed1 >> docs/experiments/walk2d_fast/eval_curves.csv
 set -e
 dir=$1; variant=$2
+kept=$dir
+[ -d "$dir/checkpoints" ] && kept=$dir/checkpoints
 # In order of samples (sorted on the file name alone: the folder may hold _).
-for name in $(cd "$dir" && printf '%s\n' ckpt_*.pt | sort -t_ -k2 -n); do
-  c="$dir/$name"
+for name in $(cd "$kept" && printf '%s\n' ckpt_*.pt | sort -t_ -k2 -n); do
+  c="$kept/$name"
   n=$(basename "$c" .pt | cut -d_ -f2)
   j="$dir/eval_$n.json"
   [ -f "$j" ] || build/mimic2d eval "$c" --bundle runs/walk_fitted.json \
