@@ -8,7 +8,7 @@
 # Environment: RUNS, JOBS (parallel targets, default 2), MAX_LEN (bytes,
 # default: the target's largest seed, at least 4096).
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/.." || exit 1
 runs=${RUNS:-1000000}
 jobs=${JOBS:-2}
 targets=("$@")

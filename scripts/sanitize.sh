@@ -13,5 +13,5 @@ fi
 cmake --build build-asan -j"$(nproc)"
 export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-MIMIC2D_SHARED_DATA= ctest --test-dir build-asan --output-on-failure \
+MIMIC2D_SHARED_DATA='' ctest --test-dir build-asan --output-on-failure \
   -j"$(nproc)" --timeout 3000 "$@" 2>&1 | tee build-asan/ctest.log
