@@ -31,7 +31,7 @@ mapfile -t commands < <(awk '
 
 failed=0
 count=0
-cd "$sandbox"
+cd "$sandbox" || exit 1
 for command in "${commands[@]}"; do
   case "$command" in ./setup.sh*|./test.sh*|"") continue ;; esac
   count=$((count + 1))
