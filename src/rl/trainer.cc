@@ -129,8 +129,9 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   const RunOptions& run = config.run;
   std::filesystem::create_directories(run.run_dir);
   // Temp files of a run killed mid-write (WriteFileAtomic's "<name>.tmp.
-  // <pid>"): never a checkpoint, only disk space.
-  for (const auto& entry : std::filesystem::directory_iterator(run.run_dir)) {
+  // <pid>"), also of kept checkpoints: never a checkpoint, only disk space.
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(run.run_dir)) {
     if (entry.path().filename().string().find(".tmp.") != std::string::npos)
       std::filesystem::remove(entry.path());
   }

@@ -188,11 +188,13 @@ TEST(Resume, KeptCheckpointsAreNamedByTheSamplesTheyHold) {
   config.run.keep_checkpoints = true;
   config.run.checkpoint_minutes = 1e-6;  // a checkpoint every iteration
   TrainIterations(config, /*resume=*/false, 2);
+  const std::string kept = config.run.run_dir + "/checkpoints";
+  // A copy torn by a kill: the resumed run removes it.
+  WriteFileAtomic(kept + "/ckpt_192.pt.tmp.99", "torn");
   TrainIterations(config, /*resume=*/true, 1);
 
   // One copy per iteration (the final save of a run has the same name as
   // its last periodic one), each loading to the counters its name says.
-  const std::string kept = config.run.run_dir + "/checkpoints";
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(kept))
     names.push_back(entry.path().filename().string());
