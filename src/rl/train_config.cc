@@ -1,7 +1,5 @@
 #include "rl/train_config.h"
 
-#include <cpuid.h>
-
 #include "common/error.h"
 #include "common/file_io.h"
 #include "common/settings.h"
@@ -48,18 +46,6 @@ bool ParseSetting(const std::string& text, TrainingPrecision* precision) {
                             {TrainingPrecision::kFp32, TrainingPrecision::kBf16,
                              TrainingPrecision::kAuto},
                             precision);
-}
-
-bool CpuHasAmxBf16() {
-  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
-  if (!__get_cpuid_count(7, 0, &eax, &ebx, &ecx, &edx)) return false;
-  return (edx >> 22) & 1u;  // CPUID.(EAX=7, ECX=0):EDX[22] = AMX-BF16
-}
-
-TrainingPrecision ResolvePrecision(TrainingPrecision precision) {
-  if (precision != TrainingPrecision::kAuto) return precision;
-  static const bool amx = CpuHasAmxBf16();
-  return amx ? TrainingPrecision::kBf16 : TrainingPrecision::kFp32;
 }
 
 const char* SettingName(CollectionMode mode) {

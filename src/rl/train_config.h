@@ -81,19 +81,27 @@ enum class TrainingPrecision {
   // state, log-probabilities and losses. Collection acts in it too, so the
   // behavior policy is the network the update differentiates.
   kBf16,
-  // bf16 where the CPU has AMX-BF16 tiles, fp32 elsewhere: bf16 ran at
-  // 1.47x fp32 with AMX but 0.75x with AVX512-BF16 alone (docs/training.md).
+  // bf16 where this CPU runs it measurably faster, fp32 elsewhere. The
+  // CPU's features do not tell: bf16 trained at 1.47x fp32 with AMX, 0.75x
+  // on an Intel CPU with AVX512-BF16 alone and 1.7x on an AMD Zen 5 with
+  // AVX512-BF16 alone (docs/training.md), so `auto` times both.
   kAuto,
 };
+// The bf16 : fp32 speed ratio at which `auto` takes bf16; the margin keeps
+// a CPU on which both run alike on fp32, the exact arithmetic.
+inline constexpr double kAutoBf16MinSpeedup = 1.2;
 const char* SettingName(TrainingPrecision precision);
 bool ParseSetting(const std::string& text, TrainingPrecision* precision);
 inline std::string SettingChoices(TrainingPrecision) {
   return "fp32, bf16, auto";
 }
-// The precision that runs on this CPU: kAuto resolved (CpuHasAmxBf16).
+// The precision that runs on this CPU: kAuto resolved by Bf16Speedup.
+// Both are defined in rl/networks.cc (the probe needs LibTorch).
 TrainingPrecision ResolvePrecision(TrainingPrecision precision);
-// CPUID leaf 7: the AMX-BF16 instructions (Sapphire Rapids and later).
-bool CpuHasAmxBf16();
+// This CPU's bf16 : fp32 speed on the networks' arithmetic (forward +
+// backward of a policy-sized MLP on a 1024-row minibatch, best of 3 each),
+// measured once per process (about 0.5 s).
+double Bf16Speedup();
 
 // How collection shares the env threads between acting and simulating.
 enum class CollectionMode {
@@ -194,7 +202,7 @@ struct PpoOptions {
     v("training_precision", self.training_precision, Range::Any(),
       "arithmetic of the networks' matrix products in collection and "
       "update: fp32, bf16 (float32 weights and losses), or auto (bf16 "
-      "where the CPU has AMX-BF16, else fp32)");
+      "where a probe at start-up times it at least 1.2x fp32, else fp32)");
     v("collection", self.collection, Range::Any(),
       "batched: one forward pass for all environments per step, then their "
       "physics on the env threads; per_thread: each env thread acts for and "

@@ -161,9 +161,11 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   spdlog::info("{} initial-state buffers for {} views",
                s.initial_states->num_buffers(), s.reference->views().size());
   if (config.ppo.training_precision == TrainingPrecision::kAuto) {
-    spdlog::info("training precision auto: {} (AMX-BF16 {})",
-                 SettingName(ResolvePrecision(config.ppo.training_precision)),
-                 CpuHasAmxBf16() ? "present" : "absent");
+    spdlog::info(
+        "training precision auto: {} (bf16 measured at {:.2f}x fp32; "
+        "bf16 from {:.1f}x)",
+        SettingName(ResolvePrecision(config.ppo.training_precision)),
+        Bf16Speedup(), kAutoBf16MinSpeedup);
   }
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,

@@ -1,8 +1,10 @@
 #include "rl/train_config.h"
 
 #include <gtest/gtest.h>
+#include <torch/torch.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -148,19 +150,32 @@ TEST(TrainConfig, EveryShippedConfigLoadsAndValidates) {
   EXPECT_EQ(fast.ppo.batch_size(), 2048);
 }
 
-TEST(TrainConfig, AutoPrecisionIsBf16OnlyWithAmx) {
+TEST(TrainConfig, AutoPrecisionFollowsTheMeasuredBf16Speedup) {
   TrainingPrecision precision = TrainingPrecision::kFp32;
   ASSERT_TRUE(ParseSetting("auto", &precision));
   EXPECT_EQ(precision, TrainingPrecision::kAuto);
-  EXPECT_EQ(
-      ResolvePrecision(TrainingPrecision::kAuto),
-      CpuHasAmxBf16() ? TrainingPrecision::kBf16 : TrainingPrecision::kFp32);
+  // The probe times real passes: a positive, finite ratio, measured once.
+  const double speedup = Bf16Speedup();
+  EXPECT_GT(speedup, 0.0);
+  EXPECT_TRUE(std::isfinite(speedup));
+  EXPECT_EQ(Bf16Speedup(), speedup);
+  EXPECT_EQ(ResolvePrecision(TrainingPrecision::kAuto),
+            speedup >= kAutoBf16MinSpeedup ? TrainingPrecision::kBf16
+                                           : TrainingPrecision::kFp32);
   // An explicit choice is kept whatever the CPU.
   EXPECT_EQ(ResolvePrecision(TrainingPrecision::kBf16),
             TrainingPrecision::kBf16);
   EXPECT_EQ(ResolvePrecision(TrainingPrecision::kFp32),
             TrainingPrecision::kFp32);
   EXPECT_STREQ(SettingName(TrainingPrecision::kAuto), "auto");
+}
+
+TEST(TrainConfig, ProbingThePrecisionLeavesTheSeededDrawsAlone) {
+  torch::manual_seed(7);
+  const torch::Tensor expected = torch::randn({4});
+  torch::manual_seed(7);
+  (void)ResolvePrecision(TrainingPrecision::kAuto);
+  EXPECT_TRUE(torch::equal(torch::randn({4}), expected));
 }
 
 TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {

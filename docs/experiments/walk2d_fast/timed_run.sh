@@ -20,6 +20,6 @@ sed 's/^  checkpoint_minutes: .*/  checkpoint_minutes: 1/' "$config" \
   > /tmp/timed_run_config.yaml
 timeout -s INT "${minutes}m" /tmp/timed_run_mimic2d train \
   /tmp/timed_run_config.yaml --keep-checkpoints > "$dir.log" 2>&1 || true
-docs/experiments/walk2d_fast/eval_curve.sh "$dir" "$variant" | tee "$dir/eval_curve.csv"
+MIMIC2D=/tmp/timed_run_mimic2d docs/experiments/walk2d_fast/eval_curve.sh "$dir" "$variant" | tee "$dir/eval_curve.csv"
 awk -F, '$4 >= 0.9 { printf "first Succ >= 0.9: %s samples, %.1f min of training\n", $2, $3 / 60; found = 1; exit }
          END { if (!found) print "Succ 0.9 not reached" }' "$dir/eval_curve.csv"
