@@ -12,15 +12,20 @@
 namespace m2d {
 namespace {
 
-// OpenBLAS core names whose kernels use AVX2 or AVX-512 (OpenBLAS's own
-// names, as openblas_get_corename() reports them, lower case).
-bool IsVectorCore(const std::string& core) {
-  static const char* const kVectorCores[] = {
-      "haswell", "skylakex", "cooperlake", "sapphirerapids", "zen"};
-  for (const char* name : kVectorCores) {
-    if (core == name) return true;
+// How wide OpenBLAS's kernels for `core` are (OpenBLAS's own names, as
+// openblas_get_corename() reports them, lower case): 2 AVX-512, 1 AVX2,
+// 0 older or unknown.
+int CoreVectorWidth(const std::string& core) {
+  static const char* const kAvx512Cores[] = {"skylakex", "cooperlake",
+                                             "sapphirerapids"};
+  static const char* const kAvx2Cores[] = {"haswell", "zen"};
+  for (const char* name : kAvx512Cores) {
+    if (core == name) return 2;
   }
-  return false;
+  for (const char* name : kAvx2Cores) {
+    if (core == name) return 1;
+  }
+  return 0;
 }
 
 std::string Lower(std::string text) {
@@ -28,7 +33,19 @@ std::string Lower(std::string text) {
   return text;
 }
 
+// The core OPENBLAS_CORETYPE asks for, "" when it is unset or empty (then
+// OpenBLAS picks from its table).
+std::string CoreTypeFromEnvironment() {
+  const char* core = std::getenv("OPENBLAS_CORETYPE");
+  return core != nullptr ? std::string(core) : std::string();
+}
+
 }  // namespace
+
+bool OpenBlasCoreIsWeaker(const std::string& loaded,
+                          const std::string& preferred) {
+  return CoreVectorWidth(Lower(loaded)) < CoreVectorWidth(Lower(preferred));
+}
 
 std::string PreferredOpenBlasCore() {
   __builtin_cpu_init();
@@ -52,11 +69,10 @@ std::string LoadedOpenBlasCore() {
 }
 
 void UseFastestBlasKernels(char** argv) {
-  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
+  if (!CoreTypeFromEnvironment().empty()) return;
   const std::string loaded = LoadedOpenBlasCore();
   const std::string preferred = PreferredOpenBlasCore();
-  if (loaded.empty() || preferred.empty() || IsVectorCore(Lower(loaded)))
-    return;
+  if (loaded.empty() || !OpenBlasCoreIsWeaker(loaded, preferred)) return;
   setenv("OPENBLAS_CORETYPE", preferred.c_str(), /*overwrite=*/1);
   execv("/proc/self/exe", argv);
   // Only reached when exec failed: carry on with the slower kernels.
@@ -85,6 +101,14 @@ std::string DescribeBlas() {
     return "sgemm_ from " + sgemm +
            ", not OpenBLAS (slow; see m2d_blas_first in CMakeLists.txt)";
   if (loaded.empty()) return "not OpenBLAS (install libopenblas0-openmp)";
+  const std::string preferred = PreferredOpenBlasCore();
+  const std::string forced = CoreTypeFromEnvironment();
+  if (!forced.empty() && OpenBlasCoreIsWeaker(loaded, preferred)) {
+    // UseFastestBlasKernels leaves a core the user set alone.
+    return "OpenBLAS (" + loaded + " kernels, as OPENBLAS_CORETYPE=" + forced +
+           " asks; this CPU runs " + preferred +
+           "'s: unset it or set that, for faster float32)";
+  }
   return "OpenBLAS (" + loaded + " kernels)";
 }
 

@@ -5,8 +5,11 @@
 // report a generic model ("Intel Xeon Processor"), and OpenBLAS then falls
 // back to its oldest SSE3 ("Prescott") kernels: the PPO update ran 4.4x
 // slower than with its AVX-512 kernels on the development machine
-// (docs/benchmarks.md). The override, OPENBLAS_CORETYPE, is only read at
-// load time, so it has to be set before the program starts.
+// (docs/benchmarks.md). AVX2 kernels on an AVX-512 CPU are moved up too:
+// on an AMD Zen 5 OpenBLAS's AVX-512 kernels trained float32 1.3-1.4x
+// faster than its "Haswell" ones. The override, OPENBLAS_CORETYPE, is only
+// read at load time, so it has to be set before the program starts; a value
+// the user set is left alone.
 #ifndef MIMIC2D_COMMON_BLAS_KERNELS_H_
 #define MIMIC2D_COMMON_BLAS_KERNELS_H_
 
@@ -18,6 +21,12 @@ namespace m2d {
 // ("SkylakeX" with AVX-512, "Haswell" with AVX2 + FMA), or "" when the
 // CPU has neither.
 std::string PreferredOpenBlasCore();
+
+// Whether OpenBLAS's `loaded` kernels use narrower vectors than the
+// `preferred` ones (core names as OpenBLAS spells them, any case; AVX-512
+// cores > AVX2 cores ("Haswell", "Zen") > any other, e.g. "Prescott").
+bool OpenBlasCoreIsWeaker(const std::string& loaded,
+                          const std::string& preferred);
 
 // OpenBLAS's kernel choice in this process (e.g. "SkylakeX"), or "" when
 // the BLAS in use is not OpenBLAS.
@@ -36,7 +45,8 @@ void UseFastestBlasKernels(char** argv);
 std::string SgemmLibraryPath();
 
 // One line for logs, e.g. "OpenBLAS (SkylakeX kernels)", or what provides
-// sgemm_ instead.
+// sgemm_ instead; it says so when OPENBLAS_CORETYPE holds OpenBLAS to
+// weaker kernels than the CPU runs.
 std::string DescribeBlas();
 
 }  // namespace m2d

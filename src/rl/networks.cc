@@ -205,6 +205,12 @@ PrecisionScope::~PrecisionScope() {
 void ForwardInPrecision(ActorCritic& model, const torch::Tensor& obs,
                         TrainingPrecision precision, torch::Tensor* mean,
                         torch::Tensor* value) {
+  // Under bf16 the mean is the rounded network's: exact for the first
+  // minibatch's ratios, noisy after (a weight step of Adam's size moves a
+  // weight's bfloat16 copy by a whole rounding step or not at all; about
+  // KL 0.004 of noise at sigma 0.05). A float32 mean with a bfloat16
+  // gradient removed it and cost 15 % of the samples/s, with no gain in
+  // samples to learn the walk (docs/training.md, "Throughput", item 5).
   PrecisionScope scope(precision);
   *mean = model->ActionMean(obs).to(torch::kFloat);
   *value = model->Value(obs).to(torch::kFloat);

@@ -6,6 +6,7 @@
 #include <torch/torch.h>
 
 #include <cctype>
+#include <cstdlib>
 #include <string>
 
 namespace m2d {
@@ -27,11 +28,30 @@ TEST(BlasKernels, OpenBlasRunsTheKernelsTheCpuSupports) {
   const std::string preferred = PreferredOpenBlasCore();
   // A CPU with neither AVX2 nor AVX-512 has no faster kernels to ask for.
   if (preferred.empty()) return;
-  const std::string core = Lower(loaded);
-  EXPECT_TRUE(core == "haswell" || core == "skylakex" || core == "cooperlake" ||
-              core == "sapphirerapids" || core == "zen")
+  const char* forced = std::getenv("OPENBLAS_CORETYPE");
+  if (forced != nullptr && *forced != '\0' &&
+      Lower(forced) != Lower(preferred)) {
+    // A core the user set is left alone, and the log line says what it
+    // costs when it is weaker.
+    EXPECT_EQ(Lower(loaded), Lower(forced));
+    EXPECT_EQ(OpenBlasCoreIsWeaker(loaded, preferred),
+              DescribeBlas().find("unset it") != std::string::npos)
+        << DescribeBlas();
+    return;
+  }
+  EXPECT_FALSE(OpenBlasCoreIsWeaker(loaded, preferred))
       << "OpenBLAS runs its " << loaded << " kernels; this CPU supports "
       << preferred << " (" << DescribeBlas() << ")";
+}
+
+TEST(BlasKernels, AvxTwoKernelsAreWeakerOnAnAvx512Cpu) {
+  EXPECT_TRUE(OpenBlasCoreIsWeaker("Prescott", "Haswell"));
+  EXPECT_TRUE(OpenBlasCoreIsWeaker("Haswell", "SkylakeX"));
+  EXPECT_TRUE(OpenBlasCoreIsWeaker("ZEN", "SkylakeX"));  // Zen 4/5 in Debian 12
+  EXPECT_FALSE(OpenBlasCoreIsWeaker("Zen", "Haswell"));
+  EXPECT_FALSE(OpenBlasCoreIsWeaker("SkylakeX", "SkylakeX"));
+  EXPECT_FALSE(OpenBlasCoreIsWeaker("SapphireRapids", "SkylakeX"));
+  EXPECT_FALSE(OpenBlasCoreIsWeaker("CooperLake", "Haswell"));
 }
 
 // This binary links Ceres (m2d_fit), which brings ATLAS's libf77blas.so.3
