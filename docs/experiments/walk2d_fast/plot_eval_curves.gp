@@ -12,7 +12,7 @@ set ytics 0.1
 data = "docs/experiments/walk2d_fast/eval_curves.csv"
 # The floor-6e-5 runs were trained on slower machines, their wall time
 # shared: they are drawn against samples only (the first panel).
-variants = "fast fast_floor3e-5 per_thread_floor3e-5_seed1 per_thread_floor3e-5_seed2 floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_fp32_seed1"
+variants = "fast fast_floor3e-5 per_thread_floor3e-5_seed1 per_thread_floor3e-5_seed2 floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_fp32_seed1 floor6e-5_bf16_timed_zen5 exact_mean_bf16_timed_zen5"
 wall_variants = 4
 title_of(i) = i == 1 ? "batched, floor 2e-5, seed 1" : \
               i == 2 ? "batched, floor 3e-5, seed 1" : \
@@ -20,7 +20,9 @@ title_of(i) = i == 1 ? "batched, floor 2e-5, seed 1" : \
               i == 4 ? "per-thread, floor 3e-5, seed 2" : \
               i == 5 ? "per-thread, floor 6e-5, seed 1" : \
               i == 6 ? "per-thread, floor 6e-5, seed 2" : \
-                       "per-thread, floor 6e-5, seed 1, float32"
+              i == 7 ? "per-thread, floor 6e-5, seed 1, float32" : \
+              i == 8 ? "floor 6e-5, bf16, timed on a Zen 5" : \
+                       "floor 6e-5, bf16 with a float32 mean, Zen 5"
 set multiplot layout 1,2 title "Walk from 2D only (configs/walk2d_fast.yaml variants): Succ of each checkpoint, 40 rollouts"
 set xlabel "samples (millions)"
 set ylabel "Succ"
