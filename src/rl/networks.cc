@@ -210,7 +210,8 @@ void ForwardInPrecision(ActorCritic& model, const torch::Tensor& obs,
   // weight's bfloat16 copy by a whole rounding step or not at all; about
   // KL 0.004 of noise at sigma 0.05). A float32 mean with a bfloat16
   // gradient removed it and cost 15 % of the samples/s, with no gain in
-  // samples to learn the walk (docs/training.md, "Throughput", item 5).
+  // samples to learn the walk in one timed run (docs/training.md,
+  // "Throughput", item 5).
   PrecisionScope scope(precision);
   *mean = model->ActionMean(obs).to(torch::kFloat);
   *value = model->Value(obs).to(torch::kFloat);
