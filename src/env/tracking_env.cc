@@ -26,6 +26,8 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
                       std::to_string(num_observed_views));
   }
   observed_views_.resize(num_observed_views, nullptr);
+  clean_views_.resize(num_observed_views, nullptr);
+  noisy_views_.resize(num_observed_views);
   if (options_.target == TrackingTarget::kBody3D) {
     // The 3D baselines follow the initial states' motion, alone.
     if (num_observed_views != 1)
@@ -68,6 +70,11 @@ void TrackingEnv::Rebase(std::shared_ptr<const TrackingReference> reference) {
   reference_ = std::move(reference);
   std::fill(observed_views_.begin(), observed_views_.end(), nullptr);
   view_ = nullptr;
+  episode_corrupted_ = false;
+}
+
+void TrackingEnv::SetReferenceNoise(const ReferenceNoise& noise) {
+  reference_noise_ = noise;
 }
 
 void TrackingEnv::Reset(float* observation) {
@@ -130,6 +137,45 @@ void TrackingEnv::BeginEpisode(int frame) {
   episode_ = EpisodeStats();
   episode_.view_index = view_index;
   episode_.start_frame = frame;
+  episode_corrupted_ = reference_noise_.enabled();
+  if (episode_corrupted_) {
+    // The episode observes corrupted copies of its views, drawn from here
+    // on as it reaches their frames.
+    for (int k = 0; k < num_observed_views_; ++k) {
+      const TrackedView& clean = *observed_views_[k];
+      TrackedView& noisy = noisy_views_[k];
+      noisy.bundle = clean.bundle;
+      noisy.view = clean.view;
+      noisy.num_frames = clean.num_frames;
+      noisy.num_points = clean.num_points;
+      noisy.points.resize(clean.points.size());
+      noisy.normalization = clean.normalization;
+      clean_views_[k] = &clean;
+      observed_views_[k] = &noisy;
+    }
+    view_ = observed_views_[0];
+    corrupted_until_frame_ = frame - 1;
+    CorruptReferenceUpTo(frame + options_.num_future_frames);
+  }
+}
+
+void TrackingEnv::CorruptReferenceUpTo(int last_frame) {
+  last_frame = std::min(last_frame, view_->num_frames - 1);
+  for (int t = corrupted_until_frame_ + 1; t <= last_frame; ++t) {
+    for (int k = 0; k < num_observed_views_; ++k) {
+      const Keypoint2D* clean = clean_views_[k]->frame(t);
+      Keypoint2D* noisy = noisy_views_[k].points.data() +
+                          static_cast<size_t>(t) * noisy_views_[k].num_points;
+      for (int j = 0; j < noisy_views_[k].num_points; ++j) {
+        noisy[j] = clean[j];
+        if (!noisy[j].IsPresent()) continue;  // a miss stays a miss
+        CorruptKeypoint(reference_noise_.pixel_sigma_px,
+                        reference_noise_.drop_probability, rng_, unit_normal_,
+                        unit_uniform_, &noisy[j]);
+      }
+    }
+  }
+  corrupted_until_frame_ = std::max(corrupted_until_frame_, last_frame);
 }
 
 StepOutcome TrackingEnv::Step(const float* action, float* observation) {
@@ -144,6 +190,8 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
     episode_.failed = true;
     return outcome;
   }
+  if (episode_corrupted_)
+    CorruptReferenceUpTo(frame_ + options_.num_future_frames);
   ProjectCurrentPoints();
   const int num_keypoints =
       simulation_.character().keypoint_layout().num_keypoints();

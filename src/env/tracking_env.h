@@ -39,6 +39,13 @@ inline std::string SettingChoices(TrackingTarget) {
   return "image_2d, body_3d";
 }
 
+// Synthetic detector noise on the 2D reference of an episode.
+struct ReferenceNoise {
+  double pixel_sigma_px = 0.0;    // Gaussian, on x and y
+  double drop_probability = 0.0;  // a keypoint missed (confidence 0)
+  bool enabled() const { return pixel_sigma_px > 0 || drop_probability > 0; }
+};
+
 struct TrackingEnvOptions {
   SimulationOptions simulation;
   int num_future_frames = 5;               // L reference frames observed ahead
@@ -53,6 +60,13 @@ struct TrackingEnvOptions {
   // visited states. Read by whoever fills the buffers (the Trainer passes it
   // to InitialStates), not by the environment; 0 disables.
   double initial_state_noise_rad = 0.0;
+  // Detector noise on the 2D reference of training episodes, drawn afresh
+  // for each episode (clean synthetic 2D made to look detected: pixel
+  // noise (px) and misses). Read by the trainer, which sets it on its
+  // collection environments (VecEnv::SetReferenceNoise); evaluation and
+  // replays track the reference as given. 0 disables.
+  double training_reference_noise_px = 0.0;
+  double training_reference_drop = 0.0;
 
   // Every setting (common/settings.h); a training config's `env` section
   // (the simulation's fields spliced in, the reward as `env.reward`).
@@ -72,6 +86,14 @@ struct TrackingEnvOptions {
       Range::AtLeast(0),
       "Noisy S.I.: sigma (rad) added once to the joint angles of the "
       "initial-state buffers when they are filled");
+    v("training_reference_noise_px", self.training_reference_noise_px,
+      Range::AtLeast(0),
+      "training episodes' 2D reference: Gaussian detector noise drawn "
+      "afresh per episode (px; evaluation sees the reference as given)");
+    v("training_reference_drop", self.training_reference_drop,
+      Range{0, 1, /*min_open=*/false, /*max_open=*/true},
+      "training episodes' 2D reference: the chance a keypoint is missed "
+      "(confidence 0), drawn afresh per episode");
     v.Nested("reward", self.reward);
     v("target", self.target, Range::Any(),
       "image_2d (the paper's 2D reprojection reward) or body_3d (the "
@@ -80,6 +102,9 @@ struct TrackingEnvOptions {
     v.Nested("reward_3d", self.reward_3d);
   }
 
+  ReferenceNoise training_reference_noise() const {
+    return {training_reference_noise_px, training_reference_drop};
+  }
   int max_episode_steps() const {
     return static_cast<int>(max_episode_s * simulation.control_hz + 0.5);
   }
@@ -150,6 +175,11 @@ class TrackingEnv {
   // (env/reference_stream.h). Its points per frame and objects must be the
   // current one's (the observation layout); ConfigError otherwise.
   void Rebase(std::shared_ptr<const TrackingReference> reference);
+  // From the next episode on, every episode observes and is rewarded
+  // against its views' 2D through `noise`, drawn afresh (from this
+  // environment's seed) for each episode and frame; the shared reference
+  // stays as given. A disabled noise restores it from the next episode.
+  void SetReferenceNoise(const ReferenceNoise& noise);
   // Advances one control period. Writes the next observation unless the
   // episode ended (the caller resets).
   StepOutcome Step(const float* action, float* observation);
@@ -171,6 +201,9 @@ class TrackingEnv {
 
  private:
   void BeginEpisode(int frame);
+  // With reference noise: the episode's noisy views hold frames up to
+  // `last_frame` (drawn the first time an episode reaches them).
+  void CorruptReferenceUpTo(int last_frame);
   void ProjectCurrentPoints();
   void ReadBodyKinematics();
   // Target body_3d: the episode's 3D reference at `frame`.
@@ -189,6 +222,17 @@ class TrackingEnv {
   const TrackedView* view_ = nullptr;  // observed_views_[0]
   int frame_ = 0;
   EpisodeStats episode_;
+
+  // Reference noise: per observed view, the reference as given and the
+  // episode's corrupted copy of it (observed_views_ then points here),
+  // filled frame by frame up to corrupted_until_frame_.
+  ReferenceNoise reference_noise_;
+  bool episode_corrupted_ = false;  // the episode observes noisy_views_
+  std::vector<const TrackedView*> clean_views_;
+  std::vector<TrackedView> noisy_views_;
+  int corrupted_until_frame_ = -1;
+  std::normal_distribution<double> unit_normal_{0.0, 1.0};
+  std::uniform_real_distribution<double> unit_uniform_{0.0, 1.0};
 
   // Scratch buffers, sized once (per observed view where projected).
   BodyKinematics bodies_;

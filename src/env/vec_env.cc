@@ -35,6 +35,10 @@ VecEnv::VecEnv(std::shared_ptr<const Character> character,
   finished_stats_.resize(num_envs);
 }
 
+void VecEnv::SetReferenceNoise(const ReferenceNoise& noise) {
+  for (auto& env : envs_) env->SetReferenceNoise(noise);
+}
+
 void VecEnv::Reset() {
   const int count = num_envs();
 #pragma omp parallel for schedule(static) num_threads(num_threads_)

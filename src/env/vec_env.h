@@ -56,6 +56,9 @@ class VecEnv {
   // Calls on disjoint ranges may run concurrently.
   void StepRange(int begin, int end, std::vector<FinishedEpisode>* finished);
 
+  // Every environment's TrackingEnv::SetReferenceNoise (training).
+  void SetReferenceNoise(const ReferenceNoise& noise);
+
   TrackingEnv& env(int i) { return *envs_[i]; }
   int num_threads() const { return num_threads_; }
 

@@ -558,14 +558,9 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
         keypoint.x_px = projection.pixel_px.x();
         keypoint.y_px = projection.pixel_px.y();
         keypoint.confidence = projection.in_front ? 1.0 : 0.0;
-        if (options.noise.pixel_sigma_px > 0) {
-          keypoint.x_px += options.noise.pixel_sigma_px * unit_normal(rng);
-          keypoint.y_px += options.noise.pixel_sigma_px * unit_normal(rng);
-        }
-        if (options.noise.drop_probability > 0 &&
-            unit_uniform(rng) < options.noise.drop_probability) {
-          keypoint = Keypoint2D{std::nan(""), std::nan(""), 0.0};
-        }
+        CorruptKeypoint(options.noise.pixel_sigma_px,
+                        options.noise.drop_probability, rng, unit_normal,
+                        unit_uniform, &keypoint);
       }
     }
     bundle.views.push_back(std::move(view));
@@ -573,6 +568,20 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
   bundle.ground_truth = std::move(truth);
   ValidateBundle(bundle, name);
   return bundle;
+}
+
+void CorruptKeypoint(double pixel_sigma_px, double drop_probability,
+                     std::mt19937_64& rng,
+                     std::normal_distribution<double>& unit_normal,
+                     std::uniform_real_distribution<double>& unit_uniform,
+                     Keypoint2D* keypoint) {
+  if (pixel_sigma_px > 0) {
+    keypoint->x_px += pixel_sigma_px * unit_normal(rng);
+    keypoint->y_px += pixel_sigma_px * unit_normal(rng);
+  }
+  if (drop_probability > 0 && unit_uniform(rng) < drop_probability) {
+    *keypoint = Keypoint2D{std::nan(""), std::nan(""), 0.0};
+  }
 }
 
 std::vector<ViewSummary> SummarizeBundle(const ReferenceBundle& bundle) {

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,16 @@ struct DetectorNoiseOptions {
   }
   void Validate() const;  // throws ConfigError
 };
+
+// One keypoint through a synthetic detector: Gaussian noise of
+// `pixel_sigma_px` on x and y, then a miss (NaN, confidence 0) with chance
+// `drop_probability`. Draws only what is enabled, in that order, from the
+// caller's distributions, so that a seed reproduces a clip.
+void CorruptKeypoint(double pixel_sigma_px, double drop_probability,
+                     std::mt19937_64& rng,
+                     std::normal_distribution<double>& unit_normal,
+                     std::uniform_real_distribution<double>& unit_uniform,
+                     Keypoint2D* keypoint);
 
 enum class CameraFollow {
   kStatic,     // cameras stay where the rig put them

@@ -67,6 +67,7 @@ double MeasureSimulationBound(const TrainConfig& config, int steps) {
                         config.data.bundles, TrainingTaskOptions(config));
   VecEnv envs(task.character, task.reference, task.initial_states, config.env,
               config.ppo.num_envs, config.run.seed, config.run.env_threads);
+  envs.SetReferenceNoise(config.env.training_reference_noise());
   envs.Reset();
   std::mt19937_64 rng(config.run.seed);
   std::normal_distribution<float> noise(

@@ -83,8 +83,9 @@ enum class TrainingPrecision {
   kBf16,
   // bf16 where this CPU runs it measurably faster, fp32 elsewhere. The
   // CPU's features do not tell: bf16 trained at 1.47x fp32 with AMX, 0.75x
-  // on an Intel CPU with AVX512-BF16 alone and 1.7x on an AMD Zen 5 with
-  // AVX512-BF16 alone (docs/training.md), so `auto` times both.
+  // on an Intel CPU with AVX512-BF16 alone and 1.03-1.22x on an AMD Zen 5
+  // with AVX512-BF16 alone (1.7x against AVX2 fp32 kernels;
+  // docs/training.md), so `auto` times both.
   kAuto,
 };
 // The bf16 : fp32 speed ratio at which `auto` takes bf16; the margin keeps

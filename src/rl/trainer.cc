@@ -170,6 +170,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
+  s.envs->SetReferenceNoise(config.env.training_reference_noise());
   if (config.asi.enabled) {
     s.asi = std::make_unique<AsiUpdater>(s.character, s.reference,
                                          s.initial_states, config.env,

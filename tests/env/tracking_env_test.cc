@@ -275,6 +275,83 @@ TEST(TrackingEnv, KViewsAreObservedAsTheirOneViewBlocksSideBySide) {
   EXPECT_THROW(both.ResetTo(1, 5, start, obs_both.data()), ConfigError);
 }
 
+// Training's reference noise: an episode observes and is rewarded against
+// its view's 2D with detector noise of the asked size, drawn afresh for
+// each episode and reproducible from the seed; the shared reference, and an
+// environment that was not asked (evaluation), see the 2D as given.
+TEST(TrackingEnv, ReferenceNoiseCorruptsEachEpisodesOwnCopy) {
+  TrackingTask task = testing::MakeGlidingTask(/*num_views=*/1);
+  TrackingEnvOptions options;
+  options.early_exit = false;  // every frame of the clip is reached
+  options.training_reference_noise_px = 4.0;
+  options.training_reference_drop = 0.1;
+  TrackingEnv clean(task.character, task.reference, task.initial_states,
+                    options, /*seed=*/7);
+  TrackingEnv noisy(task.character, task.reference, task.initial_states,
+                    options, /*seed=*/7);
+  TrackingEnv again(task.character, task.reference, task.initial_states,
+                    options, /*seed=*/7);
+  noisy.SetReferenceNoise(options.training_reference_noise());
+  again.SetReferenceNoise(options.training_reference_noise());
+  const TrackedView& given = task.reference->views()[0];
+  const std::vector<Keypoint2D> given_points = given.points;
+  const SimState& start = task.initial_states->buffer(0).entry(0, 0).state;
+  std::vector<float> obs_clean(clean.observation_size()),
+      obs_noisy(noisy.observation_size()), obs_again(again.observation_size());
+  std::vector<float> action(clean.action_size(), 0.0f);
+  clean.ResetTo(0, 0, start, obs_clean.data());
+  noisy.ResetTo(0, 0, start, obs_noisy.data());
+  again.ResetTo(0, 0, start, obs_again.data());
+  EXPECT_NE(obs_clean, obs_noisy);  // the future reference frames differ
+  EXPECT_EQ(obs_noisy, obs_again);  // reproducible from the seed
+  bool rewards_differ = false;
+  for (int step = 0; step < given.num_frames - 1; ++step) {
+    StepOutcome a = clean.Step(action.data(), obs_clean.data());
+    StepOutcome b = noisy.Step(action.data(), obs_noisy.data());
+    StepOutcome c = again.Step(action.data(), obs_again.data());
+    ASSERT_FALSE(a.diverged || b.diverged);
+    rewards_differ |= a.reward != b.reward;  // the same physics, other 2D
+    EXPECT_EQ(b.reward, c.reward);
+    if (a.truncated) break;
+  }
+  EXPECT_TRUE(rewards_differ);
+  // Over the clip: the noise's size and the share of misses.
+  const TrackedView& seen = noisy.view();
+  ASSERT_EQ(seen.num_frames, given.num_frames);
+  int present = 0, missed = 0;
+  double sum_sq_px = 0.0;
+  for (int t = 0; t < given.num_frames; ++t) {
+    for (int j = 0; j < given.num_points; ++j) {
+      const Keypoint2D& truth = given.frame(t)[j];
+      const Keypoint2D& corrupted = seen.frame(t)[j];
+      if (!truth.IsPresent()) continue;
+      EXPECT_EQ(clean.view().frame(t)[j].x_px, truth.x_px);
+      ++present;
+      if (!corrupted.IsPresent()) {
+        ++missed;
+        continue;
+      }
+      sum_sq_px += std::pow(corrupted.x_px - truth.x_px, 2) +
+                   std::pow(corrupted.y_px - truth.y_px, 2);
+    }
+  }
+  ASSERT_GT(present, 400);
+  EXPECT_NEAR(static_cast<double>(missed) / present, 0.1, 0.04);
+  EXPECT_NEAR(std::sqrt(sum_sq_px / (2.0 * (present - missed))), 4.0, 0.5);
+  // The shared reference is untouched; the next episode draws new noise.
+  for (size_t i = 0; i < given_points.size(); ++i)
+    ASSERT_EQ(given.points[i].x_px, given_points[i].x_px);
+  const Keypoint2D first = seen.frame(0)[0];
+  noisy.ResetTo(0, 0, start, obs_noisy.data());
+  EXPECT_NE(noisy.view().frame(0)[0].x_px, first.x_px);
+  // Turned off, the next episode sees the 2D as given.
+  noisy.SetReferenceNoise(ReferenceNoise());
+  noisy.ResetTo(0, 0, start, obs_noisy.data());
+  clean.ResetTo(0, 0, start, obs_clean.data());
+  EXPECT_EQ(obs_noisy, obs_clean);
+  EXPECT_EQ(&noisy.view(), &given);
+}
+
 // The 3D baselines' target: from the reference's own state the character is
 // on its 3D reference (every reward term near its weight), observes its own
 // and the reference's keypoints relative to its root, and a character that
