@@ -2,7 +2,28 @@
 
 #include <omp.h>
 
+#include "env/reward.h"
+
 namespace m2d {
+namespace {
+
+// The worst keypoint's distance (px) between `env`'s character, as the
+// camera of its episode's view sees it, and the 2D of its current frame.
+double WorstKeypointErrorPx(const TrackingEnv& env) {
+  const int num_keypoints =
+      env.simulation().character().keypoint_layout().num_keypoints();
+  return MeasureReprojection(env.projected_px().data(), env.in_front(),
+                             env.view().frame(env.frame()), num_keypoints)
+      .max_px;
+}
+
+// Scores that place an entry below any critic value: one beyond the bound
+// (replaced first), and the anchor put in its place until the next
+// rescoring gives it its own.
+constexpr double kEntryOffReferenceScore = -1e30;
+constexpr double kAnchorPlaceholderScore = -1e29;
+
+}  // namespace
 
 AsiUpdater::AsiUpdater(std::shared_ptr<const Character> character,
                        std::shared_ptr<const TrackingReference> reference,
@@ -37,8 +58,12 @@ void AsiUpdater::CaptureRange(VecEnv& envs, int step, int begin, int end,
   for (int i = begin; i < end; ++i) {
     if (envs.terminated()[i] || envs.truncated()[i]) continue;
     TrackingEnv& env = envs.env(i);
+    const double worst_px = WorstKeypointErrorPx(env);
+    if (options_.max_entry_error_px > 0 &&
+        !(worst_px <= options_.max_entry_error_px))
+      continue;
     into->states.push_back({initial_states_->BufferOf(env.episode().view_index),
-                            env.episode().view_index, env.frame(),
+                            env.episode().view_index, env.frame(), worst_px,
                             env.simulation().Save()});
     const float* row =
         envs.observations() + static_cast<size_t>(i) * observation_size;
@@ -80,7 +105,7 @@ void AsiUpdater::Update(const Critic& critic, int iteration) {
         ObservedAt(states[i].buffer, frame, e)
             .Keep(kept, states[i].view,
                   captured_.observations.data() + i * observation_size,
-                  static_cast<int>(observation_size));
+                  static_cast<int>(observation_size), states[i].worst_error_px);
         break;
       }
     }
@@ -148,18 +173,39 @@ void AsiUpdater::RescoreAll(const Critic& critic) {
       std::copy(observed.raw.begin(), observed.raw.end(), row);
       continue;
     }
-    scoring_envs_[omp_get_thread_num()]->ResetTo(slot.view, slot.frame, state,
-                                                 row);
-    observed.Keep(state, slot.view, row, observation_size);
+    TrackingEnv& env = *scoring_envs_[omp_get_thread_num()];
+    env.ResetTo(slot.view, slot.frame, state, row);
+    observed.Keep(state, slot.view, row, observation_size,
+                  WorstKeypointErrorPx(env));
   }
 
   torch::Tensor raw = torch::from_blob(
       batch.data(), {static_cast<int64_t>(slots.size()), observation_size});
   torch::Tensor scores = critic(raw).to(torch::kDouble).contiguous();
   const double* score = scores.data_ptr<double>();
+  const double bound_px = options_.max_entry_error_px;
   for (size_t k = 0; k < slots.size(); ++k) {
-    initial_states_->buffer(slots[k].buffer)
-        .Rescore(slots[k].frame, slots[k].entry, score[k]);
+    const Slot& slot = slots[k];
+    StateBuffer& buffer = initial_states_->buffer(slot.buffer);
+    const double worst_px =
+        observed_[slot.buffer][slot.frame][slot.entry].worst_error_px;
+    const SimState* anchor = buffer.anchor(slot.frame);
+    auto is_anchor = [&] {
+      const SimState& state = buffer.entry(slot.frame, slot.entry).state;
+      return anchor != nullptr && state.qpos == anchor->qpos &&
+             state.qvel == anchor->qvel;
+    };
+    // The anchor stays whatever its error: it is the frame's own start.
+    if (bound_px <= 0 || worst_px <= bound_px || is_anchor()) {
+      buffer.Rescore(slot.frame, slot.entry, score[k]);
+      continue;
+    }
+    // Off the reference: the lowest score, then (with an anchor) the
+    // anchor in its place, which Insert puts in the lowest entry.
+    buffer.Rescore(slot.frame, slot.entry, kEntryOffReferenceScore);
+    ++num_entries_replaced_;
+    if (anchor != nullptr)
+      buffer.Insert(slot.frame, *anchor, kAnchorPlaceholderScore);
   }
 }
 

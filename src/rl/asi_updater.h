@@ -33,6 +33,7 @@ class AsiUpdater {
     int buffer = 0;  // InitialStates::BufferOf(the episode's view)
     int view = 0;    // the episode's view
     int frame = 0;
+    double worst_error_px = 0.0;  // its worst keypoint against the frame's 2D
     SimState state;
   };
   // States offered during a rollout, with their raw observations (row i of
@@ -45,7 +46,8 @@ class AsiUpdater {
   // Forgets the previous rollout's captures.
   void BeginRollout();
   // At rollout step `step`, every capture_every_steps steps: offers the
-  // state and observation of every environment whose episode goes on.
+  // state and observation of every environment whose episode goes on and
+  // whose worst keypoint is within max_entry_error_px (when set).
   void Capture(VecEnv& envs, int step);
   // The same for environments [begin, end) only, into `into` (a collecting
   // thread's own list; safe to call concurrently on disjoint ranges), and
@@ -55,8 +57,12 @@ class AsiUpdater {
   void Add(const Captures& captures);
   // Scores the captures into the buffers; every rescore_every_iterations
   // iterations also rescores every kept entry (each seen from a random view
-  // its buffer serves), observing them on `num_threads` OpenMP threads.
+  // its buffer serves), observing them on `num_threads` OpenMP threads, and
+  // replaces the entries beyond max_entry_error_px with their frame's
+  // anchor (e.g. entries of a resumed run kept before the bound was set).
   void Update(const Critic& critic, int iteration);
+  // Entries replaced by that bound so far (this process).
+  int64_t num_entries_replaced() const { return num_entries_replaced_; }
 
  private:
   // A buffer entry's raw observation from `view`, kept with the part of the
@@ -68,14 +74,16 @@ class AsiUpdater {
     int view = -1;  // -1: never observed
     std::vector<double> qpos, qvel;
     std::vector<float> raw;
+    double worst_error_px = 0.0;  // its worst keypoint, seen from `view`
 
     // Whether `raw` is the observation of `state` from `view`.
     bool Holds(const SimState& state, int from_view) const {
       return view == from_view && state.qpos == qpos && state.qvel == qvel;
     }
-    void Keep(const SimState& state, int from_view, const float* row,
-              int size) {
+    void Keep(const SimState& state, int from_view, const float* row, int size,
+              double worst_px) {
       view = from_view;
+      worst_error_px = worst_px;
       qpos = state.qpos;
       qvel = state.qvel;
       raw.assign(row, row + size);
@@ -93,6 +101,7 @@ class AsiUpdater {
   std::vector<std::unique_ptr<TrackingEnv>> scoring_envs_;
   std::mt19937_64 rng_;  // the view each entry is rescored from
   Captures captured_;
+  int64_t num_entries_replaced_ = 0;
   std::vector<std::vector<std::vector<ObservedEntry>>> observed_;  // [b][f][e]
 };
 

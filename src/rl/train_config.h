@@ -221,6 +221,13 @@ struct AsiOptions {
   // moves; an entry's stored score ages).
   int rescore_every_iterations = 10;
   StateBufferOptions buffer{4, 2.0};  // per frame: 4 states, T = 2 (of V)
+  // A state is kept for frame t only while its worst keypoint, projected by
+  // the view it is seen from, lies within this of frame t's 2D (px); entries
+  // beyond it are replaced by the frame's anchor at rescoring. Without it
+  // the best-scored entries lie 2-3x farther from the 2D than the fit's
+  // states, yet 40 px learned the walk slower (docs/training.md, "ASI"):
+  // 0, no bound (any state of a running episode), by default.
+  double max_entry_error_px = 0.0;
   // Hard-view sampling (rl/hard_views.h): the share of episode starts drawn
   // in proportion to each view's estimated chance that a rollout of the
   // whole view fails; 0: every view alike. Independent of `enabled`.
@@ -240,6 +247,9 @@ struct AsiOptions {
       "every kept entry is rescored by the critic every this many "
       "iterations");
     decltype(self.buffer)::VisitFields(self.buffer, v);
+    v("max_entry_error_px", self.max_entry_error_px, Range::AtLeast(0),
+      "states are kept only while their worst keypoint is within this of "
+      "their frame's 2D (px); 0: no bound");
     v("hard_view_share", self.hard_view_share, Range::Closed(0, 1),
       "share of episode starts drawn in proportion to each view's estimated "
       "chance of failing a whole rollout (hard-view sampling); 0: uniform "

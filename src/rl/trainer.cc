@@ -419,9 +419,20 @@ TrainSummary Trainer::Run(
     const Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;
     if (s.asi) {
+      const int64_t replaced_before = s.asi->num_entries_replaced();
       s.asi->Update(
           [&](const torch::Tensor& raw) { return s.CriticValue(raw); },
           s.counters.iteration);
+      const int64_t replaced = s.asi->num_entries_replaced() - replaced_before;
+      if (replaced > 0) {
+        // Said once (a resumed run's old entries); later ones at debug level.
+        spdlog::log(
+            replaced_before == 0 ? spdlog::level::info : spdlog::level::debug,
+            "ASI: {} entries farther than asi.max_entry_error_px "
+            "({} px) from their frame's 2D replaced by the frame's "
+            "anchor",
+            replaced, config.asi.max_entry_error_px);
+      }
     }
     // 3b. Where episodes start: views weighed by their failures.
     if (s.hard_views) {

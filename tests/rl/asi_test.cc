@@ -142,6 +142,28 @@ TEST(Asi, WithoutAsiTheNoisyBuffersStayAsFilled) {
   fs::remove_all(dir);
 }
 
+// Six iterations of 6 environments x 8 steps under sinusoidal actions of
+// `amplitude` (normalized units), every state offered to `asi`, each
+// iteration ending with its update (rescoring every other iteration).
+void RunCapturingIterations(const testing::WalkTask& task,
+                            const AsiUpdater::Critic& critic, float amplitude,
+                            AsiUpdater& asi) {
+  VecEnv envs(task.character, task.reference, task.initial_states, task.options,
+              6, 3, 2);
+  envs.Reset();
+  int64_t step = 0;
+  for (int iteration = 1; iteration <= 6; ++iteration) {
+    asi.BeginRollout();
+    for (int t = 0; t < 8; ++t, ++step) {
+      for (int i = 0; i < envs.num_envs() * envs.action_size(); ++i)
+        envs.actions()[i] = amplitude * std::sin(0.1f * i + 0.3f * step);
+      envs.Step();
+      asi.Capture(envs, t);
+    }
+    asi.Update(critic, iteration);
+  }
+}
+
 // Rescoring reuses the observation each entry was captured or last scored
 // with, as long as the entry holds the same state: every score must be the
 // critic's value of the entry's own observation from a view its buffer
@@ -155,23 +177,10 @@ TEST(Asi, RescoringScoresEveryEntrysOwnObservation) {
   options.rescore_every_iterations = 2;
   AsiUpdater asi(task.character, task.reference, task.initial_states,
                  task.options, options, 3, 2);
-  VecEnv envs(task.character, task.reference, task.initial_states, task.options,
-              6, 3, 2);
-  envs.Reset();
   const AsiUpdater::Critic critic = [](const torch::Tensor& raw) {
     return raw.to(torch::kDouble).sum(1);
   };
-  int64_t step = 0;
-  for (int iteration = 1; iteration <= 6; ++iteration) {
-    asi.BeginRollout();
-    for (int t = 0; t < 8; ++t, ++step) {
-      for (int i = 0; i < envs.num_envs() * envs.action_size(); ++i)
-        envs.actions()[i] = 0.3f * std::sin(0.1f * i + 0.3f * step);
-      envs.Step();
-      asi.Capture(envs, t);
-    }
-    asi.Update(critic, iteration);
-  }
+  RunCapturingIterations(task, critic, 0.3f, asi);
 
   // Every entry against its observations from each view of its buffer.
   const InitialStates& states = *task.initial_states;
@@ -198,6 +207,77 @@ TEST(Asi, RescoringScoresEveryEntrysOwnObservation) {
     }
   }
   EXPECT_GT(checked, 60);
+}
+
+// The worst keypoint's distance (px) of `state` at `frame` from the 2D of
+// the nearest of its buffer's views.
+double NearestViewWorstErrorPx(const testing::WalkTask& task, int buffer,
+                               int frame, const SimState& state) {
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 0);
+  std::vector<float> observation(env.observation_size());
+  const int num_keypoints = task.character->keypoint_layout().num_keypoints();
+  double nearest = 1e300;
+  for (size_t v = 0; v < task.reference->views().size(); ++v) {
+    if (task.initial_states->BufferOf(static_cast<int>(v)) != buffer) continue;
+    env.ResetTo(static_cast<int>(v), frame, state, observation.data());
+    nearest = std::min(
+        nearest, MeasureReprojection(env.projected_px().data(), env.in_front(),
+                                     task.reference->views()[v].frame(frame),
+                                     num_keypoints)
+                     .max_px);
+  }
+  return nearest;
+}
+
+// With asi.max_entry_error_px, the buffers keep only states near their
+// frame's 2D, however highly the critic scores the others: a state 1 m off
+// (what a resumed run's buffers may hold) gives way to the frame's anchor
+// at the next rescoring, and captures of characters that wander off (the
+// sinusoidal actions below) never enter.
+TEST(Asi, KeepsOnlyStatesNearTheirFrames2D) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(walk_path, 2.0);
+  constexpr double kBoundPx = 30.0;
+  constexpr int kFarFrame = 5;
+  AsiOptions options;
+  options.capture_every_steps = 1;
+  options.rescore_every_iterations = 2;
+  options.max_entry_error_px = kBoundPx;
+  AsiUpdater asi(task.character, task.reference, task.initial_states,
+                 task.options, options, 3, 2);
+  StateBuffer& buffer = task.initial_states->buffer(0);
+  SimState far = buffer.entry(kFarFrame, 0).state;
+  far.qpos[task.character->root_qpos_address()] += 1.0;
+  ASSERT_TRUE(buffer.Insert(kFarFrame, far, 1e9));
+  ASSERT_GT(NearestViewWorstErrorPx(task, 0, kFarFrame, far), 3 * kBoundPx);
+
+  // A critic that prizes every state alike, far or near.
+  const AsiUpdater::Critic critic = [](const torch::Tensor& raw) {
+    return torch::full({raw.size(0)}, 100.0, torch::kDouble);
+  };
+  RunCapturingIterations(task, critic, 0.8f, asi);
+
+  EXPECT_GE(asi.num_entries_replaced(), 1);
+  const InitialStates& states = *task.initial_states;
+  int checked = 0, visited = 0;
+  for (int b = 0; b < states.num_buffers(); ++b) {
+    const StateBuffer& kept = states.buffer(b);
+    for (int f = 0; f < kept.num_frames(); ++f) {
+      const SimState* anchor = kept.anchor(f);
+      for (int e = 0; e < kept.size(f); ++e) {
+        const SimState& state = kept.entry(f, e).state;
+        EXPECT_NE(state.qpos, far.qpos) << "frame " << f;
+        ++checked;
+        if (anchor != nullptr && state.qpos == anchor->qpos) continue;
+        ++visited;
+        EXPECT_LE(NearestViewWorstErrorPx(task, b, f, state), kBoundPx)
+            << "buffer " << b << " frame " << f << " entry " << e;
+      }
+    }
+  }
+  EXPECT_GT(checked, 60);
+  EXPECT_GT(visited, 10);  // captures did enter, within the bound
 }
 
 }  // namespace
