@@ -42,6 +42,10 @@ AsiUpdater::AsiUpdater(std::shared_ptr<const Character> character,
   }
 }
 
+double AsiUpdater::BoundedErrorPx(const TrackingEnv& env) const {
+  return options_.max_entry_error_px > 0 ? WorstKeypointErrorPx(env) : 0.0;
+}
+
 void AsiUpdater::BeginRollout() {
   captured_.states.clear();
   captured_.observations.clear();
@@ -58,10 +62,8 @@ void AsiUpdater::CaptureRange(VecEnv& envs, int step, int begin, int end,
   for (int i = begin; i < end; ++i) {
     if (envs.terminated()[i] || envs.truncated()[i]) continue;
     TrackingEnv& env = envs.env(i);
-    const double worst_px = WorstKeypointErrorPx(env);
-    if (options_.max_entry_error_px > 0 &&
-        !(worst_px <= options_.max_entry_error_px))
-      continue;
+    const double worst_px = BoundedErrorPx(env);
+    if (!(worst_px <= options_.max_entry_error_px)) continue;
     into->states.push_back({initial_states_->BufferOf(env.episode().view_index),
                             env.episode().view_index, env.frame(), worst_px,
                             env.simulation().Save()});
@@ -175,8 +177,7 @@ void AsiUpdater::RescoreAll(const Critic& critic) {
     }
     TrackingEnv& env = *scoring_envs_[omp_get_thread_num()];
     env.ResetTo(slot.view, slot.frame, state, row);
-    observed.Keep(state, slot.view, row, observation_size,
-                  WorstKeypointErrorPx(env));
+    observed.Keep(state, slot.view, row, observation_size, BoundedErrorPx(env));
   }
 
   torch::Tensor raw = torch::from_blob(

@@ -33,7 +33,7 @@ class AsiUpdater {
     int buffer = 0;  // InitialStates::BufferOf(the episode's view)
     int view = 0;    // the episode's view
     int frame = 0;
-    double worst_error_px = 0.0;  // its worst keypoint against the frame's 2D
+    double worst_error_px = 0.0;  // BoundedErrorPx at its capture
     SimState state;
   };
   // States offered during a rollout, with their raw observations (row i of
@@ -74,7 +74,7 @@ class AsiUpdater {
     int view = -1;  // -1: never observed
     std::vector<double> qpos, qvel;
     std::vector<float> raw;
-    double worst_error_px = 0.0;  // its worst keypoint, seen from `view`
+    double worst_error_px = 0.0;  // BoundedErrorPx, seen from `view`
 
     // Whether `raw` is the observation of `state` from `view`.
     bool Holds(const SimState& state, int from_view) const {
@@ -89,6 +89,10 @@ class AsiUpdater {
       raw.assign(row, row + size);
     }
   };
+  // `env`'s worst keypoint against its frame's 2D (px) when
+  // max_entry_error_px bounds the entries; 0 (not measured) otherwise, so
+  // that collection without the bound does no extra work.
+  double BoundedErrorPx(const TrackingEnv& env) const;
   // The kept observation of entry `entry` of `frame` in `buffer`, grown on
   // first use.
   ObservedEntry& ObservedAt(int buffer, int frame, int entry);
