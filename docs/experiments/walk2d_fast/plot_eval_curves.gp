@@ -33,3 +33,25 @@ set arrow from 30, 0 to 30, 1 nohead dashtype 2 lc rgb "black"
 plot for [i=1:wall_variants] data using (strcol(1) eq word(variants, i) ? $3 / 60 : NaN):4 \
      with linespoints title title_of(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
 unset multiplot
+
+# The critic's size and the epochs (sessions 36-38, one core each on the
+# Zen 5, against the shipped config's three runs): against samples only,
+# since their wall times were shared with other runs and pauses.
+set output "docs/images/samples_to_learn_critic.png"
+set terminal pngcairo size 900,560 font ",11" noenhanced
+unset arrow
+critic_variants = "floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_bf16_timed_zen5 epochs2_floor9e-5_zen5_1core epochs2_floor9e-5_critic256_zen5_1core critic1024x512_zen5_1core critic1024x512_seed2_zen5_1core critic1024x512_epochs2_floor9e-5_zen5_1core critic1024x512_epochs2_floor9e-5_seed2_zen5_1core"
+critic_title(i) = i == 1 ? "shipped, seed 1" : \
+                  i == 2 ? "shipped, seed 2" : \
+                  i == 3 ? "shipped, timed on the Zen 5" : \
+                  i == 4 ? "2 epochs, floor 9e-5" : \
+                  i == 5 ? "critic 256/256, 2 epochs, floor 9e-5" : \
+                  i == 6 ? "critic 1024/512, seed 1" : \
+                  i == 7 ? "critic 1024/512, seed 2" : \
+                  i == 8 ? "critic 1024/512, 2 epochs, floor 9e-5, seed 1" : \
+                           "critic 1024/512, 2 epochs, floor 9e-5, seed 2"
+set title "Walk from 2D only: the critic's size and the epochs (Succ of each checkpoint, 40 rollouts)"
+set xlabel "samples (millions)"
+set xrange [4:16]
+plot for [i=1:words(critic_variants)] data using (strcol(1) eq word(critic_variants, i) ? $2 / 1e6 : NaN):4 \
+     with linespoints lw (i <= 3 ? 2.5 : 1.2) title critic_title(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
