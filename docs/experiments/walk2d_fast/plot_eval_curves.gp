@@ -38,9 +38,9 @@ unset multiplot
 # Zen 5, against the shipped config's three runs): against samples only,
 # since their wall times were shared with other runs and pauses.
 set output "docs/images/samples_to_learn_critic.png"
-set terminal pngcairo size 900,560 font ",11" noenhanced
+set terminal pngcairo size 1000,620 font ",11" noenhanced
 unset arrow
-critic_variants = "floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_bf16_timed_zen5 epochs2_floor9e-5_zen5_1core epochs2_floor9e-5_critic256_zen5_1core critic1024x512_zen5_1core critic1024x512_seed2_zen5_1core critic1024x512_epochs2_floor9e-5_zen5_1core critic1024x512_epochs2_floor9e-5_seed2_zen5_1core"
+critic_variants = "floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_bf16_timed_zen5 epochs2_floor9e-5_zen5_1core epochs2_floor9e-5_critic256_zen5_1core critic1024x512_zen5_1core critic1024x512_seed2_zen5_1core critic1024x512_epochs2_floor9e-5_zen5_1core critic1024x512_epochs2_floor9e-5_seed2_zen5_1core critic1024x256_zen5_1core critic1024x256_seed2_zen5_1core"
 critic_title(i) = i == 1 ? "shipped, seed 1" : \
                   i == 2 ? "shipped, seed 2" : \
                   i == 3 ? "shipped, timed on the Zen 5" : \
@@ -49,7 +49,9 @@ critic_title(i) = i == 1 ? "shipped, seed 1" : \
                   i == 6 ? "critic 1024/512, seed 1" : \
                   i == 7 ? "critic 1024/512, seed 2" : \
                   i == 8 ? "critic 1024/512, 2 epochs, floor 9e-5, seed 1" : \
-                           "critic 1024/512, 2 epochs, floor 9e-5, seed 2"
+                  i == 9 ? "critic 1024/512, 2 epochs, floor 9e-5, seed 2" : \
+                  i == 10 ? "critic 1024/256, seed 1" : \
+                            "critic 1024/256, seed 2"
 set title "Walk from 2D only: the critic's size and the epochs (Succ of each checkpoint, 40 rollouts)"
 set xlabel "samples (millions)"
 set xrange [4:16]
