@@ -52,7 +52,7 @@ critic_title(i) = i == 1 ? "shipped, seed 1" : \
                   i == 9 ? "critic 1024/512, 2 epochs, floor 9e-5, seed 2" : \
                   i == 10 ? "critic 1024/256, seed 1" : \
                             "critic 1024/256, seed 2"
-set title "Walk from 2D only: the critic's size and the epochs (Succ of each checkpoint, 40 rollouts)"
+set title "Walk from 2D only: the critic's size and the epochs (Succ of each checkpoint, 40 rollouts from the fit's starts and cameras)"
 set xlabel "samples (millions)"
 set xrange [4:16]
 plot for [i=1:words(critic_variants)] data using (strcol(1) eq word(critic_variants, i) ? $2 / 1e6 : NaN):4 \
