@@ -90,4 +90,27 @@ void WriteRootRelativePoints(const Eigen::Vector3d* points_m, int num_points,
   }
 }
 
+void WriteCriticOnlyInputs(const BodyKinematics& bodies,
+                           const Eigen::Vector3d* reference_now_m,
+                           const Eigen::Vector3d* reference_next_m,
+                           int num_keypoints,
+                           const Eigen::Vector3d& camera_center_m,
+                           const Eigen::Matrix3d& camera_to_world, float* out) {
+  const Eigen::Vector3d& root = bodies.positions_m[0];
+  const Eigen::Quaterniond to_heading =
+      InverseHeadingRotation(bodies.orientations[0]);
+  WriteRootRelativePoints(reference_now_m, num_keypoints, root, to_heading,
+                          out);
+  out += 3 * num_keypoints;
+  WriteRootRelativePoints(reference_next_m, num_keypoints, root, to_heading,
+                          out);
+  out += 3 * num_keypoints;
+  WriteRootRelativePoints(&camera_center_m, 1, root, to_heading, out);
+  const Eigen::Matrix3d axes = to_heading.toRotationMatrix() * camera_to_world;
+  for (int i = 0; i < 3; ++i) {
+    out[3 + i] = static_cast<float>(axes(i, 0));
+    out[6 + i] = static_cast<float>(axes(i, 1));
+  }
+}
+
 }  // namespace m2d

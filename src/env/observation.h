@@ -1,7 +1,9 @@
 // env: observations as pure functions of the simulated state and the 2D
-// reference. Nothing here sees a camera: 2D inputs are expressed relative to
-// the reference's own root and scale in the image, so two cameras that
-// produce the same image produce the same observation.
+// reference. Nothing the policy reads sees a camera: 2D inputs are expressed
+// relative to the reference's own root and scale in the image, so two
+// cameras that produce the same image produce the same observation. The one
+// exception is the optional critic-only block (asymmetric actor-critic),
+// which only the value function reads, in training.
 #ifndef MIMIC2D_ENV_OBSERVATION_H_
 #define MIMIC2D_ENV_OBSERVATION_H_
 
@@ -14,13 +16,16 @@
 namespace m2d {
 
 // Sizes of the observation's parts, in the order they are laid out:
-// [proprioception | object state | 2D block]. The 2D block is what the
-// encoder phi reads per view; the rest joins after phi.
+// [proprioception | object state | critic-only | 2D block]. The 2D block is
+// what the encoder phi reads per view; proprioception and object state join
+// after phi for the policy and the critic; the critic-only block (empty
+// unless env.critic_observes_3d) joins for the critic alone.
 struct ObservationLayout {
   int num_bodies = 0;         // character bodies in proprioception
   int num_objects = 0;        // free objects (e.g. a ball)
   int num_points = 0;         // 2D points per frame: keypoints + objects
   int num_future_frames = 0;  // L reference frames after the current one
+  int critic_only_size = 0;   // floats only the critic reads (0: none)
 
   static constexpr int kBodyFeatures = 3 + 6 + 3 + 3;  // pos, rot6, lin, ang
   static constexpr int kObjectFeatures = 6;            // position, velocity
@@ -32,7 +37,9 @@ struct ObservationLayout {
   int view_size() const {
     return (1 + num_future_frames) * num_points * kPointFeatures;
   }
-  int view_offset() const { return proprioception_size() + object_size(); }
+  // What the policy reads besides phi.
+  int actor_base_size() const { return proprioception_size() + object_size(); }
+  int view_offset() const { return actor_base_size() + critic_only_size; }
   int size() const { return view_offset() + view_size(); }
 };
 
@@ -83,6 +90,27 @@ void WriteNormalizedPoints(const Keypoint2D* points, int num_points,
 void WriteRootRelativePoints(const Eigen::Vector3d* points_m, int num_points,
                              const Eigen::Vector3d& root_m,
                              const Eigen::Quaterniond& to_heading, float* out);
+
+// The critic-only block (asymmetric actor-critic: privileged inputs for the
+// value function, which only training uses; the policy never reads them, so
+// it stays the paper's and view-invariant). Everything is in the simulated
+// root's heading frame, relative to the root:
+//  - the 3D reference's keypoints at the current and the next frame (the
+//    motion the initial states were filled from: the fit's poses with
+//    `initial_states: estimate`), num_keypoints * 3 floats each;
+//  - the episode's camera: its centre (m) and its camera-to-world rotation's
+//    first two columns (the image's x and y axes), 9 floats.
+// Why: the value of a state depends on where the 3D motion goes and on the
+// view, which the policy's inputs only imply through the 2D.
+inline int CriticOnlySize(int num_keypoints) {
+  return 2 * num_keypoints * 3 + 9;
+}
+void WriteCriticOnlyInputs(const BodyKinematics& bodies,
+                           const Eigen::Vector3d* reference_now_m,
+                           const Eigen::Vector3d* reference_next_m,
+                           int num_keypoints,
+                           const Eigen::Vector3d& camera_center_m,
+                           const Eigen::Matrix3d& camera_to_world, float* out);
 
 }  // namespace m2d
 

@@ -44,6 +44,10 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   layout_.num_objects = reference_->num_object_points();
   layout_.num_points = reference_->num_points();
   layout_.num_future_frames = options_.num_future_frames;
+  if (options_.critic_observes_3d) {
+    layout_.critic_only_size =
+        CriticOnlySize(character->keypoint_layout().num_keypoints());
+  }
 
   const int num_points = reference_->num_points();
   const int num_keypoints = character->keypoint_layout().num_keypoints();
@@ -326,6 +330,7 @@ void TrackingEnv::WriteObservation(float* observation) {
     WriteObjectState(bodies_, object_positions_, object_velocities_,
                      observation + layout_.proprioception_size());
   }
+  if (layout_.critic_only_size > 0) WriteCriticOnlyBlock(observation);
   const int num_points = layout_.num_points;
   if (options_.target == TrackingTarget::kBody3D) {
     // The 3D block: the character's keypoints, then L future reference
@@ -363,6 +368,29 @@ void TrackingEnv::WriteObservation(float* observation) {
                             out + l * stride);
     }
   }
+}
+
+void TrackingEnv::WriteCriticOnlyBlock(float* observation) const {
+  // Without a 3D reference (default starts; a streamed reference, which has
+  // no initial states) the block is zeros: the policy does not read it, and
+  // training refuses such a config (TrainConfig::Validate).
+  float* out = observation + layout_.actor_base_size();
+  if (initial_states_ == nullptr ||
+      reference_->sources().initial_states == InitialStateSource::kDefault) {
+    std::fill(out, out + layout_.critic_only_size, 0.0f);
+    return;
+  }
+  const std::vector<BodyTarget3D>& motion =
+      initial_states_->motion(initial_states_->BufferOf(episode_.view_index));
+  const int last = static_cast<int>(motion.size()) - 1;
+  const BodyTarget3D& now = motion[std::min(frame_, last)];
+  const BodyTarget3D& next = motion[std::min(frame_ + 1, last)];
+  const PinholeCamera& camera =
+      reference_->bundles()[view_->bundle].views[view_->view].CameraAt(frame_);
+  WriteCriticOnlyInputs(
+      bodies_, now.keypoints_m.data(), next.keypoints_m.data(),
+      static_cast<int>(now.keypoints_m.size()), camera.CenterWorld(),
+      camera.rotation_world_to_camera().transpose(), out);
 }
 
 }  // namespace m2d

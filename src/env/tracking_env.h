@@ -55,6 +55,10 @@ struct TrackingEnvOptions {
   RewardWeights reward;
   TrackingTarget target = TrackingTarget::kImage2D;
   Body3DRewardWeights reward_3d;  // with target body_3d (energy: reward's)
+  // Asymmetric actor-critic: observations carry the critic-only block
+  // (env/observation.h, WriteCriticOnlyInputs; the 3D reference the initial
+  // states come from, and the camera), which the policy never reads.
+  bool critic_observes_3d = false;
   // Noisy S.I.: sigma (rad) added once to the joint angles of the
   // initial-state buffers when they are filled; ASI replaces them with
   // visited states. Read by whoever fills the buffers (the Trainer passes it
@@ -100,6 +104,11 @@ struct TrackingEnvOptions {
       "3D-tracking baselines: a DeepMimic-style reward on the motion the "
       "initial states come from, 3D keypoints observed instead of 2D)");
     v.Nested("reward_3d", self.reward_3d);
+    v("critic_observes_3d", self.critic_observes_3d, Range::Any(),
+      "asymmetric actor-critic: the critic (only) also sees the 3D "
+      "reference the initial states come from (the fit's poses with "
+      "initial_states estimate) and the episode's camera; the policy's "
+      "inputs are unchanged");
   }
 
   ReferenceNoise training_reference_noise() const {
@@ -206,6 +215,8 @@ class TrackingEnv {
   void CorruptReferenceUpTo(int last_frame);
   void ProjectCurrentPoints();
   void ReadBodyKinematics();
+  // With critic_observes_3d: the critic-only block of the current frame.
+  void WriteCriticOnlyBlock(float* observation) const;
   // Target body_3d: the episode's 3D reference at `frame`.
   const BodyTarget3D& ReferenceBody(int frame) const;
 

@@ -70,7 +70,8 @@ void SaveCheckpoint(const std::string& path, const TrainConfig& config,
                                static_cast<int64_t>(layout.num_objects),
                                static_cast<int64_t>(layout.num_points),
                                static_cast<int64_t>(layout.num_future_frames),
-                               static_cast<int64_t>(model->action_size())}));
+                               static_cast<int64_t>(model->action_size()),
+                               static_cast<int64_t>(layout.critic_only_size)}));
   archive.write("iteration",
                 torch::tensor(static_cast<int64_t>(counters.iteration)));
   archive.write("samples", torch::tensor(counters.samples));
@@ -147,8 +148,9 @@ ObservationLayout SavedLayout(const std::string& path,
     torch::Tensor values;
     archive.read("layout", values);
     values = values.to(torch::kInt64).flatten();
-    if (values.numel() != 5)
-      throw InputError(path, "layout must hold 5 counts");
+    // 6 counts; checkpoints from before the critic-only block hold 5.
+    if (values.numel() != 5 && values.numel() != 6)
+      throw InputError(path, "layout must hold 5 or 6 counts");
     // Bounds far above any character, so that a damaged count is named
     // here rather than sizing networks beyond memory.
     auto count = [&](int index, const char* name, int64_t low, int64_t high) {
@@ -167,6 +169,8 @@ ObservationLayout SavedLayout(const std::string& path,
     layout.num_points = count(2, "num_points", 1, 1000);
     layout.num_future_frames = count(3, "num_future_frames", 0, 1000);
     *action_size = count(4, "action_size", 1, 1000);
+    if (values.numel() == 6)
+      layout.critic_only_size = count(5, "critic_only_size", 0, 100000);
     return layout;
   });
 }
@@ -214,9 +218,11 @@ void CheckSameNetwork(const std::string& path,
       {"objects", layout.num_objects},
       {"2D points per frame", layout.num_points},
       {"future frames (env.num_future_frames)", layout.num_future_frames},
-      {"actions", model->action_size()}};
-  for (int i = 0; i < 5; ++i) {
-    const int64_t saved = values[i].item<int64_t>();
+      {"actions", model->action_size()},
+      {"critic-only inputs (env.critic_observes_3d)", layout.critic_only_size}};
+  values = values.to(torch::kInt64).flatten();
+  for (int i = 0; i < 6; ++i) {
+    const int64_t saved = i < values.numel() ? values[i].item<int64_t>() : 0;
     if (saved != fields[i].second) {
       throw InputError(path, std::string("was trained with ") +
                                  std::to_string(saved) + " " + fields[i].first +

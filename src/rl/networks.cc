@@ -72,11 +72,14 @@ ActorCriticImpl::ActorCriticImpl(const ObservationLayout& layout,
   };
   actor_encoder = register_module("actor_encoder", make_encoder());
   critic_encoder = register_module("critic_encoder", make_encoder());
-  const int joined = base_size_ + options.encoder_features;
+  // The policy reads proprioception and object state; the critic also the
+  // critic-only block when the layout has one (asymmetric actor-critic).
   actor = register_module(
-      "actor", MakeMlp(joined, options.policy_hidden, action_size, 0.01));
+      "actor", MakeMlp(layout.actor_base_size() + options.encoder_features,
+                       options.policy_hidden, action_size, 0.01));
   critic =
-      register_module("critic", MakeMlp(joined, options.critic_hidden, 1, 1.0));
+      register_module("critic", MakeMlp(base_size_ + options.encoder_features,
+                                        options.critic_hidden, 1, 1.0));
   log_std = register_parameter(
       "log_std", torch::full({action_size}, std::log(options.action_std)),
       /*requires_grad=*/options.learn_action_std);
@@ -98,8 +101,8 @@ void ActorCriticImpl::UpdateNormalizer(const torch::Tensor& raw) {
 }
 
 torch::Tensor ActorCriticImpl::Features(torch::nn::Sequential& encoder,
-                                        const torch::Tensor& obs,
-                                        int num_views) {
+                                        const torch::Tensor& obs, int num_views,
+                                        int base_width) {
   const int64_t batch = obs.size(0);
   torch::Tensor views =
       obs.narrow(1, base_size_,
@@ -107,16 +110,18 @@ torch::Tensor ActorCriticImpl::Features(torch::nn::Sequential& encoder,
           .reshape({batch * num_views, layout_.view_size()});
   torch::Tensor phi =
       encoder->forward(views).reshape({batch, num_views, -1}).mean(1);
-  return torch::cat({obs.narrow(1, 0, base_size_), phi}, 1);
+  return torch::cat({obs.narrow(1, 0, base_width), phi}, 1);
 }
 
 torch::Tensor ActorCriticImpl::ActionMean(const torch::Tensor& obs,
                                           int num_views) {
-  return actor->forward(Features(actor_encoder, obs, num_views));
+  return actor->forward(
+      Features(actor_encoder, obs, num_views, layout_.actor_base_size()));
 }
 
 torch::Tensor ActorCriticImpl::Value(const torch::Tensor& obs, int num_views) {
-  return critic->forward(Features(critic_encoder, obs, num_views)).squeeze(1);
+  return critic->forward(Features(critic_encoder, obs, num_views, base_size_))
+      .squeeze(1);
 }
 
 torch::Tensor ActorCriticImpl::LogProb(const torch::Tensor& mean,

@@ -2,7 +2,9 @@
 // projection + future reference, per view) goes through an encoder phi;
 // phi's features are averaged over the K views given (K = 1 in training,
 // K > 1 for zero-shot multi-view tracking); proprioception and object state
-// join after phi. Policy: MLP -> Gaussian mean over normalized PD targets.
+// join after phi, and for the critic alone the critic-only block when the
+// observation has one. Policy: MLP -> Gaussian mean over normalized PD
+// targets.
 #ifndef MIMIC2D_RL_NETWORKS_H_
 #define MIMIC2D_RL_NETWORKS_H_
 
@@ -52,9 +54,11 @@ class ActorCriticImpl : public torch::nn::Module {
   int action_size() const { return action_size_; }
 
  private:
-  // phi averaged over the views, joined with the base features.
+  // phi averaged over the views, joined with the first `base_width` base
+  // features (the policy's, or all of them for the critic).
   torch::Tensor Features(torch::nn::Sequential& encoder,
-                         const torch::Tensor& obs, int num_views);
+                         const torch::Tensor& obs, int num_views,
+                         int base_width);
 
   ObservationLayout layout_;
   int base_size_;

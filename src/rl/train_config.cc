@@ -110,6 +110,12 @@ void TrainConfig::Validate() const {
   ppo.Validate();
   asi.Validate();
   run.Validate();
+  if (env.critic_observes_3d &&
+      data.sources().initial_states == InitialStateSource::kDefault) {
+    throw ConfigError(
+        "env.critic_observes_3d needs a 3D reference for the critic: "
+        "data.initial_states truth or estimate, not default");
+  }
 }
 
 namespace {

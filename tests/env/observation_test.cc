@@ -70,6 +70,55 @@ TEST(Observation, NormalizedPointsAreInvariantToImageShiftAndZoom) {
   EXPECT_FLOAT_EQ(a[11], 0.0f);  // NaN coordinate: missing
 }
 
+// The critic-only block: the reference's keypoints and the camera about the
+// root, in its heading frame; unchanged when the whole scene, camera
+// included, turns about +z and slides along the ground.
+TEST(Observation, CriticOnlyInputsAreRootAndHeadingRelative) {
+  std::mt19937 rng(5);
+  BodyKinematics bodies = RandomBodies(3, rng);
+  // Root at (1, 2, 0.9) facing +y (heading 90 degrees), pitched a little.
+  bodies.positions_m[0] = {1.0, 2.0, 0.9};
+  bodies.orientations[0] =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()) *
+                         Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()));
+  const std::vector<Eigen::Vector3d> now = {{1.0, 3.0, 0.9}, {0.0, 2.0, 0.1}};
+  const std::vector<Eigen::Vector3d> next = {{1.0, 2.0, 1.4}, {1.0, 2.0, 25.0}};
+  const Eigen::Vector3d camera_center(1.0, 6.0, 1.4);  // 4 m ahead, 0.5 up
+  // Image x along world -x, image y along world -z: the camera faces -y,
+  // back at the character.
+  Eigen::Matrix3d camera_to_world;
+  camera_to_world << -1, 0, 0, 0, 0, -1, 0, -1, 0;
+  constexpr int kSize = 2 * 2 * 3 + 9;
+  ASSERT_EQ(CriticOnlySize(2), kSize);
+  std::vector<float> a(kSize + 1, -7.0f);
+  WriteCriticOnlyInputs(bodies, now.data(), next.data(), 2, camera_center,
+                        camera_to_world, a.data());
+  const std::vector<float> expected = {
+      1, 0, 0,   0, 1, -0.8,  // now: 1 m ahead; 1 m to the left, low
+      0, 0, 0.5, 0, 0, 10,    // next: above the root; clipped to 10 m
+      4, 0, 0.5,              // camera centre: 4 m ahead, 0.5 m up
+      0, 1, 0,   0, 0, -1};   // image x: the root's left; image y: down
+  for (int i = 0; i < kSize; ++i) EXPECT_NEAR(a[i], expected[i], 1e-6) << i;
+  EXPECT_EQ(a[kSize], -7.0f);  // nothing written past the block
+
+  Eigen::Quaterniond turn(Eigen::AngleAxisd(-2.3, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d slide(-4.0, 1.5, 0.0);
+  auto move = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return turn * p + slide;
+  };
+  BodyKinematics moved = bodies;
+  moved.positions_m[0] = move(bodies.positions_m[0]);
+  moved.orientations[0] = turn * bodies.orientations[0];
+  std::vector<Eigen::Vector3d> moved_now, moved_next;
+  for (const Eigen::Vector3d& p : now) moved_now.push_back(move(p));
+  for (const Eigen::Vector3d& p : next) moved_next.push_back(move(p));
+  std::vector<float> b(kSize);
+  WriteCriticOnlyInputs(moved, moved_now.data(), moved_next.data(), 2,
+                        move(camera_center),
+                        turn.toRotationMatrix() * camera_to_world, b.data());
+  for (int i = 0; i < kSize; ++i) EXPECT_NEAR(a[i], b[i], 1e-5) << i;
+}
+
 // Two cameras that see the same image: the second camera and the whole
 // motion are moved by the same offset. The environment's observations must
 // be identical, because nothing camera-specific is observed.

@@ -402,5 +402,66 @@ TEST(TrackingEnv, ABody3DTargetFollowsTheInitialStatesMotion) {
                ConfigError);
 }
 
+// Asymmetric actor-critic: with critic_observes_3d the observation gains the
+// critic-only block (the initial states' 3D reference and the camera) in
+// front of the views, and everything the policy reads stays as it was.
+// Without a 3D reference (a streamed rollout has no initial states) the
+// block is zeros.
+TEST(TrackingEnv, TheCriticOnlyBlockAddsTheReferenceAndCameraAndNothingElse) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 3.0);
+  TrackingEnvOptions options = task.options;
+  options.critic_observes_3d = true;
+  TrackingEnv plain(task.character, task.reference, task.initial_states,
+                    task.options, 1);
+  TrackingEnv asymmetric(task.character, task.reference, task.initial_states,
+                         options, 1);
+  const ObservationLayout& layout = asymmetric.layout();
+  ASSERT_EQ(layout.critic_only_size, CriticOnlySize(17));
+  ASSERT_EQ(asymmetric.observation_size(),
+            plain.observation_size() + CriticOnlySize(17));
+
+  const int frame = 12;
+  const SimState& start = *task.initial_states->buffer(0).anchor(frame);
+  std::vector<float> a(plain.observation_size()),
+      b(asymmetric.observation_size());
+  plain.ResetTo(0, frame, start, a.data());
+  asymmetric.ResetTo(0, frame, start, b.data());
+  std::vector<float> action(plain.action_size(), 0.1f);
+  plain.Step(action.data(), a.data());
+  asymmetric.Step(action.data(), b.data());
+  const int base = layout.actor_base_size();
+  for (int i = 0; i < base; ++i) ASSERT_EQ(a[i], b[i]) << i;
+  for (int i = 0; i < plain.layout().view_size(); ++i)
+    ASSERT_EQ(a[base + i], b[layout.view_offset() + i]) << i;
+
+  // The block, from the simulated root after the step (frame + 1).
+  const Simulation& simulation = asymmetric.simulation();
+  const int root_id = task.character->bodies()[0];
+  const mjData* data = simulation.data();
+  BodyKinematics root;
+  root.positions_m = {Eigen::Vector3d(data->xpos + 3 * root_id)};
+  root.orientations = {Eigen::Quaterniond(
+      data->xquat[4 * root_id], data->xquat[4 * root_id + 1],
+      data->xquat[4 * root_id + 2], data->xquat[4 * root_id + 3])};
+  const std::vector<BodyTarget3D>& motion = task.initial_states->motion(0);
+  const TrackedView& view = task.reference->views()[0];
+  const PinholeCamera& camera =
+      task.reference->bundles()[view.bundle].views[view.view].CameraAt(frame +
+                                                                       1);
+  std::vector<float> expected(CriticOnlySize(17));
+  WriteCriticOnlyInputs(
+      root, motion[frame + 1].keypoints_m.data(),
+      motion[frame + 2].keypoints_m.data(), 17, camera.CenterWorld(),
+      camera.rotation_world_to_camera().transpose(), expected.data());
+  for (int i = 0; i < CriticOnlySize(17); ++i)
+    EXPECT_NEAR(b[base + i], expected[i], 1e-5) << i;
+
+  TrackingEnv streamed(task.character, task.reference, nullptr, options, 1);
+  std::vector<float> c(streamed.observation_size(), 1.0f);
+  streamed.ResetTo(0, frame, start, c.data());
+  for (int i = 0; i < CriticOnlySize(17); ++i) EXPECT_EQ(c[base + i], 0.0f);
+}
+
 }  // namespace
 }  // namespace m2d

@@ -117,7 +117,8 @@ const torch::optim::AdamParamState* AdamState(
 TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   const std::string dir = testing::TempDir("checkpoint_round_trip");
   const std::string path = dir + "/checkpoint.pt";
-  const ObservationLayout layout = SmallLayout();
+  ObservationLayout layout = SmallLayout();
+  layout.critic_only_size = 7;  // the asymmetric critic's inputs
   TrainedModel saved = MakeTrainedModel(layout, kActions, 1);
   TrainConfig config;
   config.data.bundles = {"walk.json"};  // read back, so it must validate
@@ -186,6 +187,7 @@ TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   EXPECT_EQ(read_layout.size(), layout.size());
   EXPECT_EQ(read_layout.num_bodies, layout.num_bodies);
   EXPECT_EQ(read_layout.num_future_frames, layout.num_future_frames);
+  EXPECT_EQ(read_layout.critic_only_size, 7);
   fs::remove_all(dir);
 }
 

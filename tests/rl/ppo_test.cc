@@ -90,6 +90,38 @@ TEST(Networks, AveragingIdenticalViewsEqualsOneView) {
                               model->ActionMean(ba, 2), 1e-5, 1e-6));
 }
 
+// Asymmetric actor-critic: the block between the policy's base features and
+// the views moves the value, never the action, with one view or several.
+TEST(Networks, OnlyTheCriticReadsTheCriticOnlyBlock) {
+  torch::manual_seed(1);
+  ObservationLayout layout = SmallLayout();
+  layout.critic_only_size = 5;
+  ModelOptions options;
+  options.policy_hidden = {32};
+  options.critic_hidden = {32};
+  options.encoder_hidden = {16};
+  options.encoder_features = 8;
+  ActorCritic model(layout, options, 4);
+  for (int views : {1, 2}) {
+    SCOPED_TRACE(views);
+    torch::Tensor policy_base = torch::randn({5, layout.actor_base_size()});
+    torch::Tensor blocks = torch::randn({5, views * layout.view_size()});
+    torch::Tensor a = torch::cat(
+        {policy_base, torch::randn({5, layout.critic_only_size}), blocks}, 1);
+    torch::Tensor b = torch::cat(
+        {policy_base, torch::randn({5, layout.critic_only_size}), blocks}, 1);
+    EXPECT_TRUE(
+        torch::equal(model->ActionMean(a, views), model->ActionMean(b, views)));
+    EXPECT_FALSE(torch::allclose(model->Value(a, views), model->Value(b, views),
+                                 1e-3, 1e-4));
+    // The views still start at view_offset(): changing them moves both.
+    torch::Tensor c = a.clone();
+    c.narrow(1, layout.view_offset(), 1).add_(3.0);
+    EXPECT_FALSE(torch::allclose(model->ActionMean(a, views),
+                                 model->ActionMean(c, views), 1e-3, 1e-4));
+  }
+}
+
 TEST(Networks, ABf16ScopeRoundsOnlyWithinItAndStaysNearFloat32) {
   torch::manual_seed(4);
   ObservationLayout layout = SmallLayout();

@@ -433,7 +433,9 @@ TEST(Resume, AChangedStructuralSettingFailsBeforeAnythingIsWritten) {
   more_future.env.num_future_frames = config.env.num_future_frames + 3;
   TrainConfig wider = config;
   wider.model.policy_hidden = {48};
-  for (const TrainConfig& changed : {more_future, wider}) {
+  TrainConfig asymmetric = config;
+  asymmetric.env.critic_observes_3d = true;
+  for (const TrainConfig& changed : {more_future, wider, asymmetric}) {
     std::string message;
     try {
       Trainer trainer(changed, /*resume=*/true);
@@ -443,7 +445,8 @@ TEST(Resume, AChangedStructuralSettingFailsBeforeAnythingIsWritten) {
     EXPECT_NE(message.find(run_dir + "/checkpoint.pt"), std::string::npos)
         << message;
     EXPECT_TRUE(message.find("future frames") != std::string::npos ||
-                message.find("network differs") != std::string::npos)
+                message.find("network differs") != std::string::npos ||
+                message.find("critic-only inputs") != std::string::npos)
         << message;
     EXPECT_EQ(contents(run_dir + "/config.yaml"), config_before);
     EXPECT_EQ(contents(run_dir + "/train_log.csv"), log_before);

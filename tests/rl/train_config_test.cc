@@ -187,6 +187,10 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
   ExpectConfigError(
       "data: {bundles: [a.json], initial_states: estimate, cameras: truth}\n",
       "initial_states: estimate needs cameras: estimate");
+  ExpectConfigError(
+      "data: {bundles: [a.json], initial_states: default}\n"
+      "env: {critic_observes_3d: true}\n",
+      "critic_observes_3d needs a 3D reference");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envz: 3}\n",
                     "'agent.num_envz' is not a known setting");
   ExpectConfigError("data: {bundles: [a.json]}\nagent: {num_envs: many}\n",
