@@ -44,6 +44,16 @@ ObservationLayout SmallLayout() {
   return layout;
 }
 
+// Networks small enough for tests that only need their structure.
+ModelOptions SmallModel() {
+  ModelOptions options;
+  options.policy_hidden = {32};
+  options.critic_hidden = {32};
+  options.encoder_hidden = {16};
+  options.encoder_features = 8;
+  return options;
+}
+
 TEST(AdaptLearningRate, FollowsTheTargetKlWithinItsBounds) {
   PpoOptions options;
   options.target_kl = 0.01;
@@ -68,12 +78,7 @@ TEST(AdaptLearningRate, FollowsTheTargetKlWithinItsBounds) {
 TEST(Networks, AveragingIdenticalViewsEqualsOneView) {
   torch::manual_seed(0);
   ObservationLayout layout = SmallLayout();
-  ModelOptions options;
-  options.policy_hidden = {32};
-  options.critic_hidden = {32};
-  options.encoder_hidden = {16};
-  options.encoder_features = 8;
-  ActorCritic model(layout, options, 4);
+  ActorCritic model(layout, SmallModel(), 4);
   torch::Tensor base = torch::randn({5, layout.view_offset()});
   torch::Tensor view = torch::randn({5, layout.view_size()});
   torch::Tensor one = torch::cat({base, view}, 1);
@@ -96,12 +101,7 @@ TEST(Networks, OnlyTheCriticReadsTheCriticOnlyBlock) {
   torch::manual_seed(1);
   ObservationLayout layout = SmallLayout();
   layout.critic_only_size = 5;
-  ModelOptions options;
-  options.policy_hidden = {32};
-  options.critic_hidden = {32};
-  options.encoder_hidden = {16};
-  options.encoder_features = 8;
-  ActorCritic model(layout, options, 4);
+  ActorCritic model(layout, SmallModel(), 4);
   for (int views : {1, 2}) {
     SCOPED_TRACE(views);
     torch::Tensor policy_base = torch::randn({5, layout.actor_base_size()});
