@@ -66,6 +66,13 @@ int RunInfo(const InfoArgs& args) {
       Widths(config.model.encoder_hidden).c_str(),
       config.model.encoder_features, Widths(config.model.policy_hidden).c_str(),
       Widths(config.model.critic_hidden).c_str(), config.model.action_std);
+  if (info.layout.critic_only_size > 0) {
+    std::printf(
+        "  asymmetric critic: %d critic-only inputs (the camera and the 3D "
+        "reference of the initial states, %s); the policy does not read "
+        "them\n",
+        info.layout.critic_only_size, SettingName(config.data.initial_states));
+  }
   if (info.num_state_buffers > 0) {
     std::printf("  ASI buffers: %d holding %lld states\n",
                 info.num_state_buffers,
