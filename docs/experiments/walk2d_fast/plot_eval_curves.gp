@@ -57,3 +57,17 @@ set xlabel "samples (millions)"
 set xrange [4:16]
 plot for [i=1:words(critic_variants)] data using (strcol(1) eq word(critic_variants, i) ? $2 / 1e6 : NaN):4 \
      with linespoints lw (i <= 3 ? 2.5 : 1.2) title critic_title(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
+
+# The asymmetric critic (session 39: env.critic_observes_3d, one core each on
+# the Zen 5, and a timed 2-core run) against the shipped config's three runs.
+set output "docs/images/samples_to_learn_asymmetric.png"
+asym_variants = "floor6e-5_bf16_seed1 floor6e-5_bf16_seed2 floor6e-5_bf16_timed_zen5 critic3d_seed1_zen5_1core critic3d_seed2_zen5_1core critic3d_timed_zen5"
+asym_title(i) = i == 1 ? "shipped, seed 1" : \
+                i == 2 ? "shipped, seed 2" : \
+                i == 3 ? "shipped, timed on the Zen 5" : \
+                i == 4 ? "asymmetric critic, seed 1" : \
+                i == 5 ? "asymmetric critic, seed 2" : \
+                         "asymmetric critic, timed on the Zen 5"
+set title "Walk from 2D only: the asymmetric critic (Succ of each checkpoint, 40 rollouts from the fit's starts and cameras)"
+plot for [i=1:words(asym_variants)] data using (strcol(1) eq word(asym_variants, i) ? $2 / 1e6 : NaN):4 \
+     with linespoints lw (i <= 3 ? 1.2 : 2.5) title asym_title(i), 0.9 with lines dashtype 2 lc rgb "gray" notitle
