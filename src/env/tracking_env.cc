@@ -293,8 +293,9 @@ void TrackingEnv::ProjectCurrentPoints() {
 }
 
 const BodyTarget3D& TrackingEnv::ReferenceBody(int frame) const {
-  return initial_states_->motion(
-      initial_states_->BufferOf(episode_.view_index))[frame];
+  const std::vector<BodyTarget3D>& motion =
+      initial_states_->motion(initial_states_->BufferOf(episode_.view_index));
+  return motion[std::min(frame, static_cast<int>(motion.size()) - 1)];
 }
 
 void TrackingEnv::ReadBodyKinematics() {
@@ -380,11 +381,8 @@ void TrackingEnv::WriteCriticOnlyBlock(float* observation) const {
     std::fill(out, out + layout_.critic_only_size, 0.0f);
     return;
   }
-  const std::vector<BodyTarget3D>& motion =
-      initial_states_->motion(initial_states_->BufferOf(episode_.view_index));
-  const int last = static_cast<int>(motion.size()) - 1;
-  const BodyTarget3D& now = motion[std::min(frame_, last)];
-  const BodyTarget3D& next = motion[std::min(frame_ + 1, last)];
+  const BodyTarget3D& now = ReferenceBody(frame_);
+  const BodyTarget3D& next = ReferenceBody(frame_ + 1);
   const PinholeCamera& camera =
       reference_->bundles()[view_->bundle].views[view_->view].CameraAt(frame_);
   WriteCriticOnlyInputs(

@@ -217,7 +217,9 @@ class TrackingEnv {
   void ReadBodyKinematics();
   // With critic_observes_3d: the critic-only block of the current frame.
   void WriteCriticOnlyBlock(float* observation) const;
-  // Target body_3d: the episode's 3D reference at `frame`.
+  // The episode's 3D reference (the initial states' motion) at `frame`,
+  // held at its last frame beyond it: target body_3d's reference, and the
+  // critic-only block's.
   const BodyTarget3D& ReferenceBody(int frame) const;
 
   std::shared_ptr<const TrackingReference> reference_;
