@@ -7,7 +7,8 @@
 # eval_curve.csv: variant,samples,succ_pct,e2d_px,e3d_root_rel_mm,pa_mpjpe_mm,mean_frames.
 #   docs/experiments/dataset2d_critic3d/eval_curve.sh runs/dataset2d_critic3d critic3d \
 #     >> docs/experiments/dataset2d_critic3d/eval_curve.csv
-# A single checkpoint file instead of a run folder evaluates that one.
+# A single checkpoint file instead of a run folder evaluates that one (its
+# eval JSON is cached beside it, as <checkpoint>.eval.json).
 # MIMIC2D names the binary (default build/mimic2d), DATA the bundles' folder
 # (default runs/dataset, scripts/make_dataset.sh).
 set -euo pipefail
