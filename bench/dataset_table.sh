@@ -14,6 +14,8 @@
 # and SFV_CHECKPOINT name others). Every rollout starts at a
 # clip's first frame and runs to its end (clips are 0.8-4.4 s): one rollout
 # per view. Prints a Markdown table; every row's eval JSON goes to OUT_DIR.
+# SUCCESS_MEASURE=mean_keypoint judges Succ by a frame's mean keypoint
+# error instead of its worst (eval --success-measure; docs/tracking.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data=${1:-runs/dataset}
@@ -30,6 +32,7 @@ unseen_clips="dance_spin roll"
 ours=${OURS_CHECKPOINT:-runs/dataset2d/checkpoint.pt}
 gt=${GT_CHECKPOINT:-runs/dataset3d_gt/checkpoint.pt}
 sfv=${SFV_CHECKPOINT:-runs/dataset_sfv/checkpoint.pt}
+measure=${SUCCESS_MEASURE:-worst_keypoint}
 
 # bundles SPLIT SUFFIX: --bundle flags for the split's clips.
 bundles() {
@@ -61,7 +64,8 @@ row() {
   [ "$noise" = noisy ] && noisy=_noisy
   # shellcheck disable=SC2046
   $bin eval "$checkpoint" $(bundles "$split" "$noisy$suffix") \
-    --episodes 1 --episode-s 10 "$@" -o "$out/$tag.json" > "$out/$tag.txt"
+    --episodes 1 --episode-s 10 --success-measure "$measure" "$@" \
+    -o "$out/$tag.json" > "$out/$tag.txt"
   # The "all" line: clip view eps frames Succ% E2D EO2D E3D E3Droot E3DPA Jitter.
   # (mawk, Debian's awk, reserves `split`: the clips go in as `clips`.)
   awk -v name="$name" -v clips="$split" -v noise="$noise" '

@@ -184,6 +184,7 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
       {"starts_from_checkpoint_buffers", evaluation.checkpoint_buffers},
       {"episode_s", options.episode_s},
       {"success_threshold_px", options.success_threshold_px},
+      {"success_measure", SettingName(options.success_measure)},
       {"views_at_once", options.num_views},
       {"rows", nlohmann::json::array()},
       {"all", RowToJson(AggregateRows(rows))}};

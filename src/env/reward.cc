@@ -76,8 +76,11 @@ ReprojectionError CombineViewErrors(const ReprojectionError* errors,
   return combined;
 }
 
-bool ShouldExitEarly(const ReprojectionError& error, double max_error_px) {
-  return error.any_behind_camera || error.max_px > max_error_px;
+bool ShouldExitEarly(const ReprojectionError& error, double max_error_px,
+                     FrameErrorMeasure measure) {
+  const double frame_error_px =
+      measure == FrameErrorMeasure::kWorst ? error.max_px : error.mean_px;
+  return error.any_behind_camera || frame_error_px > max_error_px;
 }
 
 Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,

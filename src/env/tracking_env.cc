@@ -246,7 +246,8 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
 
   if (off_3d_reference ||
       (options_.early_exit &&
-       ShouldExitEarly(outcome.error, options_.early_exit_max_error_px))) {
+       ShouldExitEarly(outcome.error, options_.early_exit_max_error_px,
+                       options_.early_exit_measure))) {
     outcome.terminated = true;
     episode_.failed = true;
     return outcome;

@@ -52,6 +52,9 @@ struct TrackingEnvOptions {
   double max_episode_s = 10.0;             // episodes are truncated after this
   bool early_exit = true;                  // reprojection early exit on/off
   double early_exit_max_error_px = 100.0;  // worst-keypoint error that ends it
+  // Which error early_exit_max_error_px bounds: training keeps the worst
+  // keypoint; evaluation may judge by the mean (EvalOptions).
+  FrameErrorMeasure early_exit_measure = FrameErrorMeasure::kWorst;
   RewardWeights reward;
   TrackingTarget target = TrackingTarget::kImage2D;
   Body3DRewardWeights reward_3d;  // with target body_3d (energy: reward's)
@@ -86,6 +89,10 @@ struct TrackingEnvOptions {
       "early_exit_max_error_px (the paper's reprojection early exit)");
     v("early_exit_max_error_px", self.early_exit_max_error_px, Range::Above(0),
       "the early exit's threshold (px)");
+    v("early_exit_measure", self.early_exit_measure, Range::Any(),
+      "which frame error the threshold bounds: worst_keypoint (the paper's "
+      "'max reprojection', as read here) or mean_keypoint (PHC's success "
+      "rule in pixels)");
     v("initial_state_noise_rad", self.initial_state_noise_rad,
       Range::AtLeast(0),
       "Noisy S.I.: sigma (rad) added once to the joint angles of the "

@@ -84,6 +84,7 @@ std::vector<EvalRow> EvaluatePolicy(
   TrackingEnvOptions eval_env = env_options;
   eval_env.early_exit = true;
   eval_env.early_exit_max_error_px = options.success_threshold_px;
+  eval_env.early_exit_measure = options.success_measure;
   eval_env.max_episode_s = options.episode_s;
   // Every policy is judged by the same 2D criterion, whatever it was
   // trained to follow (a 3D baseline's own 3D exit is off).

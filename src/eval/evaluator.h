@@ -19,6 +19,10 @@ struct EvalOptions {
   double episode_s = 10.0;              // episode length (clip end cuts it)
   double success_threshold_px = 100.0;  // a frame whose worst keypoint is off
                                         // by more fails the rollout
+  // Which frame error the threshold bounds: the worst keypoint's (the
+  // paper's "max reprojection" as we read it; every table of docs/) or the
+  // mean over keypoints (PHC's rule in pixels), for comparison.
+  FrameErrorMeasure success_measure = FrameErrorMeasure::kWorst;
   // K: views observed at once (zero-shot multi-view tracking, phi averaged
   // over them). K > 1 evaluates, for every bundle with at least K views and
   // each of its views in turn, that view with the K - 1 next ones (in the

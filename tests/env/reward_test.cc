@@ -74,6 +74,23 @@ TEST(Reward, EarlyExitThreshold) {
   EXPECT_TRUE(ShouldExitEarly(error, 100.0));
 }
 
+TEST(Reward, EarlyExitByTheMeanKeypoint) {
+  // One keypoint 150 px off, the frame's mean 40 px: the worst-keypoint
+  // rule ends the episode, the mean rule does not until the mean passes.
+  ReprojectionError error;
+  error.max_px = 150.0;
+  error.mean_px = 40.0;
+  EXPECT_TRUE(ShouldExitEarly(error, 100.0, FrameErrorMeasure::kWorst));
+  EXPECT_FALSE(ShouldExitEarly(error, 100.0, FrameErrorMeasure::kMean));
+  error.mean_px = 101.0;
+  EXPECT_TRUE(ShouldExitEarly(error, 100.0, FrameErrorMeasure::kMean));
+  // A keypoint behind the camera ends it under either rule.
+  error.max_px = error.mean_px = 0.0;
+  error.any_behind_camera = true;
+  EXPECT_TRUE(ShouldExitEarly(error, 100.0, FrameErrorMeasure::kMean));
+  EXPECT_TRUE(ShouldExitEarly(error, 100.0, FrameErrorMeasure::kWorst));
+}
+
 TEST(Reward, WeightsAreValidated) {
   RewardWeights weights;
   weights.pose_alpha_per_px = 0.0;

@@ -72,6 +72,39 @@ TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
   EXPECT_EQ(all.succ, 0.0);
 }
 
+TEST(EvaluatePolicy, TheMeanKeypointRuleFailsNoRolloutEarlier) {
+  // A frame's mean error never exceeds its worst keypoint's, so judged by
+  // the mean every rollout lasts at least as long; the standing character
+  // loses a limb's keypoint past 100 px before the frame's mean, so some
+  // last longer.
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  auto rows_by = [&](FrameErrorMeasure measure) {
+    EvalOptions options;
+    options.episodes_per_view = 2;
+    options.episode_s = 3.0;
+    options.success_measure = measure;
+    return EvaluatePolicy(policy, task.character, task.reference,
+                          task.initial_states, task.options, options);
+  };
+  const std::vector<EvalRow> by_worst = rows_by(FrameErrorMeasure::kWorst);
+  const std::vector<EvalRow> by_mean = rows_by(FrameErrorMeasure::kMean);
+  ASSERT_EQ(by_worst.size(), by_mean.size());
+  int frames_by_worst = 0, frames_by_mean = 0;
+  for (size_t r = 0; r < by_worst.size(); ++r) {
+    ASSERT_EQ(by_worst[r].rollouts.size(), by_mean[r].rollouts.size());
+    for (size_t k = 0; k < by_worst[r].rollouts.size(); ++k) {
+      EXPECT_EQ(by_worst[r].rollouts[k].start_frame,
+                by_mean[r].rollouts[k].start_frame);
+      EXPECT_GE(by_mean[r].rollouts[k].frames, by_worst[r].rollouts[k].frames);
+      frames_by_worst += by_worst[r].rollouts[k].frames;
+      frames_by_mean += by_mean[r].rollouts[k].frames;
+    }
+  }
+  EXPECT_GT(frames_by_mean, frames_by_worst);
+}
+
 TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
