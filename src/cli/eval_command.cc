@@ -19,7 +19,7 @@ struct EvalArgs {
   std::string starts;   // "": the checkpoint's config
   std::string cameras;  // "": the checkpoint's config
   bool asi_starts = false;
-  std::string success_measure = "worst_keypoint";
+  std::string success_measure = SettingName(FrameErrorMeasure::kWorst);
 };
 
 int RunEval(const EvalArgs& args) {
@@ -70,14 +70,16 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
       ->capture_default_str();
   eval->add_option(
           "--success-px", args->options.success_threshold_px,
-          "A frame whose worst keypoint is off by more fails the rollout (px)")
+          "A frame whose error (--success-measure) is off by more fails the "
+          "rollout (px)")
       ->capture_default_str();
   eval->add_option("--success-measure", args->success_measure,
                    "Which frame error --success-px bounds: worst_keypoint "
                    "(the paper's 'max reprojection' as read here; every "
                    "table of docs/) or mean_keypoint (PHC's success rule in "
                    "pixels, for comparison)")
-      ->check(CLI::IsMember({"worst_keypoint", "mean_keypoint"}))
+      ->check(CLI::IsMember({SettingName(FrameErrorMeasure::kWorst),
+                             SettingName(FrameErrorMeasure::kMean)}))
       ->capture_default_str();
   eval->add_option("--views", args->options.num_views,
                    "K: views tracked at once (zero-shot multi-view: phi "

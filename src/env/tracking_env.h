@@ -51,7 +51,7 @@ struct TrackingEnvOptions {
   int num_future_frames = 5;               // L reference frames observed ahead
   double max_episode_s = 10.0;             // episodes are truncated after this
   bool early_exit = true;                  // reprojection early exit on/off
-  double early_exit_max_error_px = 100.0;  // worst-keypoint error that ends it
+  double early_exit_max_error_px = 100.0;  // frame error that ends it (px)
   // Which error early_exit_max_error_px bounds: training keeps the worst
   // keypoint; evaluation may judge by the mean (EvalOptions).
   FrameErrorMeasure early_exit_measure = FrameErrorMeasure::kWorst;
@@ -85,8 +85,8 @@ struct TrackingEnvOptions {
     v("max_episode_s", self.max_episode_s, Range::Above(0),
       "episodes are truncated after this (s)");
     v("early_exit", self.early_exit, Range::Any(),
-      "end an episode when its worst keypoint is off by more than "
-      "early_exit_max_error_px (the paper's reprojection early exit)");
+      "end an episode when a frame's error (early_exit_measure) is more "
+      "than early_exit_max_error_px (the paper's reprojection early exit)");
     v("early_exit_max_error_px", self.early_exit_max_error_px, Range::Above(0),
       "the early exit's threshold (px)");
     v("early_exit_measure", self.early_exit_measure, Range::Any(),

@@ -17,8 +17,9 @@ namespace m2d {
 struct EvalOptions {
   int episodes_per_view = 10;           // start frames spread over the clip
   double episode_s = 10.0;              // episode length (clip end cuts it)
-  double success_threshold_px = 100.0;  // a frame whose worst keypoint is off
-                                        // by more fails the rollout
+  double success_threshold_px = 100.0;  // a frame whose error (by
+                                        // success_measure) is off by more
+                                        // fails the rollout
   // Which frame error the threshold bounds: the worst keypoint's (the
   // paper's "max reprojection" as we read it; every table of docs/) or the
   // mean over keypoints (PHC's rule in pixels), for comparison.
