@@ -12,29 +12,16 @@
 #include "common/error.h"
 #include "env/env_fixture.h"
 #include "env/task.h"
+#include "small_networks.h"
 #include "test_paths.h"
 
 namespace m2d {
 namespace {
 
+using testing::SmallLayout;
+using testing::SmallModel;
+
 namespace fs = std::filesystem;
-
-ObservationLayout SmallLayout() {
-  ObservationLayout layout;
-  layout.num_bodies = 2;
-  layout.num_points = 3;
-  layout.num_future_frames = 2;
-  return layout;
-}
-
-ModelOptions TinyModel() {
-  ModelOptions options;
-  options.encoder_hidden = {16};
-  options.encoder_features = 8;
-  options.policy_hidden = {32};
-  options.critic_hidden = {32};
-  return options;
-}
 
 constexpr int kActions = 4;
 
@@ -55,7 +42,7 @@ TrainedModel MakeTrainedModel(const ObservationLayout& layout, int actions,
                               uint64_t seed) {
   torch::manual_seed(seed);
   TrainedModel trained;
-  trained.model = ActorCritic(layout, TinyModel(), actions);
+  trained.model = ActorCritic(layout, SmallModel(), actions);
   trained.optimizer = std::make_unique<torch::optim::Adam>(
       trained.model->parameters(), torch::optim::AdamOptions(1e-3));
   for (int step = 0; step < 3; ++step) {
@@ -74,7 +61,7 @@ TrainedModel MakeFreshModel(const ObservationLayout& layout, int actions,
                             uint64_t seed) {
   torch::manual_seed(seed);
   TrainedModel fresh;
-  fresh.model = ActorCritic(layout, TinyModel(), actions);
+  fresh.model = ActorCritic(layout, SmallModel(), actions);
   fresh.optimizer = std::make_unique<torch::optim::Adam>(
       fresh.model->parameters(), torch::optim::AdamOptions(1e-3));
   return fresh;
@@ -123,7 +110,7 @@ TEST(Checkpoint, CountersModelAndOptimizerRoundTrip) {
   TrainConfig config;
   config.data.bundles = {"walk.json"};  // read back, so it must validate
   config.ppo.num_envs = 24;  // 24 x 32 steps: room for the 512 minibatch
-  config.model = TinyModel();
+  config.model = SmallModel();
   CheckpointCounters counters;
   counters.iteration = 37;
   counters.samples = 123'456'789'012;  // past 2^32
@@ -477,7 +464,7 @@ TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffersAndInfoSaysSo) {
   TrainConfig config;
   config.data.bundles = {"walk.json"};  // read back, so it must validate
   config.ppo.num_envs = 24;
-  config.model = TinyModel();
+  config.model = SmallModel();
   TrainedModel saved = MakeTrainedModel(SmallLayout(), kActions, 1);
   for (auto& group : saved.optimizer->param_groups())
     group.options().set_lr(1.75e-5);

@@ -5,10 +5,14 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "small_networks.h"
 #include "test_paths.h"
 
 namespace m2d {
 namespace {
+
+using testing::SmallLayout;
+using testing::SmallModel;
 
 TEST(Gae, MatchesAHandComputedExample) {
   // Two steps, one env; the episode ends after step 1.
@@ -34,24 +38,6 @@ TEST(Gae, BootstrapsFromTheLastValueWhenNotDone) {
   ComputeGae(rewards, values, dones, last, 0.5, 1.0, &advantages, &returns);
   EXPECT_NEAR(advantages[0][0].item<float>(), 5.0f, 1e-6);
   EXPECT_NEAR(advantages[0][1].item<float>(), 0.0f, 1e-6);
-}
-
-ObservationLayout SmallLayout() {
-  ObservationLayout layout;
-  layout.num_bodies = 2;
-  layout.num_points = 3;
-  layout.num_future_frames = 2;
-  return layout;
-}
-
-// Networks small enough for tests that only need their structure.
-ModelOptions SmallModel() {
-  ModelOptions options;
-  options.policy_hidden = {32};
-  options.critic_hidden = {32};
-  options.encoder_hidden = {16};
-  options.encoder_features = 8;
-  return options;
 }
 
 TEST(AdaptLearningRate, FollowsTheTargetKlWithinItsBounds) {

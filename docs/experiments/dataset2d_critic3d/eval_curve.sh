@@ -10,16 +10,23 @@
 # A single checkpoint file instead of a run folder evaluates that one (its
 # eval JSON is cached beside it, as <checkpoint>.eval.json).
 # MIMIC2D names the binary (default build/mimic2d), DATA the bundles' folder
-# (default runs/dataset, scripts/make_dataset.sh).
+# (default runs/dataset, scripts/make_dataset.sh). TRUTH=1 evaluates a 3D-GT
+# run instead (configs/dataset3d_gt.yaml): the truth bundles, with the truth's
+# starts and the true cameras, as the table's 3D-GT row.
 set -euo pipefail
 mimic2d=${MIMIC2D:-build/mimic2d}
 data=${DATA:-runs/dataset}
 target=$1 variant=$2
 clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"
 args=()
-for clip in $clips; do args+=(--bundle "$data/$clip.json"); done
-args+=(--truth)
-for clip in $clips; do args+=("$data/${clip}_truth.json"); done
+if [ "${TRUTH:-0}" = 1 ]; then
+  for clip in $clips; do args+=(--bundle "$data/${clip}_truth.json"); done
+  args+=(--starts truth --cameras truth)
+else
+  for clip in $clips; do args+=(--bundle "$data/$clip.json"); done
+  args+=(--truth)
+  for clip in $clips; do args+=("$data/${clip}_truth.json"); done
+fi
 
 # evaluate CHECKPOINT JSON SAMPLES: one row (the eval JSON is cached).
 evaluate() {
