@@ -65,14 +65,15 @@ int RunTrain(const TrainArgs& args) {
     double iteration_s = p.collect_s + p.update_s + p.asi_s;
     std::printf(
         "it %5d | %10lld samples | %6.0f samples/s (collect %2.0f%% update "
-        "%2.0f%% asi %2.0f%%, %d thr) | "
+        "%2.0f%% asi %2.0f%%, %d thr%s) | "
         "return %7.2f | len %5.1f | Succ %5.1f%% | E2D %6.1f px | kl %.4f "
         "clip %4.1f%% lr %.1e | ETA %s\n",
         p.iteration, static_cast<long long>(p.samples), p.samples_per_s,
         100 * p.collect_s / iteration_s, 100 * p.update_s / iteration_s,
-        100 * p.asi_s / iteration_s, p.torch_threads, p.mean_return,
-        p.mean_episode_length, 100 * p.succ, p.e2d_px, p.approx_kl,
-        100 * p.clip_fraction, p.learning_rate, FormatDuration(eta_s).c_str());
+        100 * p.asi_s / iteration_s, p.torch_threads, p.bf16 ? " bf16" : "",
+        p.mean_return, p.mean_episode_length, 100 * p.succ, p.e2d_px,
+        p.approx_kl, 100 * p.clip_fraction, p.learning_rate,
+        FormatDuration(eta_s).c_str());
     std::fflush(stdout);
   };
   TrainSummary summary =

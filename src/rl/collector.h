@@ -31,6 +31,11 @@ class RolloutCollector {
   // options.collection chooses how the env threads are used.
   void Collect(ActorCritic& policy, AsiUpdater* asi, RolloutStorage& storage,
                std::vector<FinishedEpisode>* finished);
+  // The arithmetic of the next collections (the trainer's speed tuner may
+  // change it between iterations).
+  void set_precision(TrainingPrecision precision) {
+    options_.training_precision = precision;
+  }
 
  private:
   // One thread's share of the environments under kPerThread.

@@ -81,8 +81,10 @@ enum class TrainingPrecision {
   // state, log-probabilities and losses. Collection acts in it too, so the
   // behavior policy is the network the update differentiates.
   kBf16,
-  // bf16 where this CPU runs it measurably faster, fp32 elsewhere. The
-  // CPU's features do not tell: bf16 trained at 1.47x fp32 with AMX, 0.75x
+  // bf16 where this CPU runs it measurably faster, fp32 elsewhere: a probe
+  // at start-up picks, then the trainer's speed tuner re-measures both in
+  // real iterations (rl/speed_tuner.h; the answer can flip with the load).
+  // The CPU's features do not tell: bf16 trained at 1.47x fp32 with AMX, 0.75x
   // on an Intel CPU with AVX512-BF16 alone and 1.03-1.22x on an AMD Zen 5
   // with AVX512-BF16 alone (1.7x against AVX2 fp32 kernels;
   // docs/training.md), so `auto` times both.
@@ -147,7 +149,7 @@ struct PpoOptions {
   bool normalize_observations = true;  // running mean/std, saved with model
   int torch_threads = 1;  // LibTorch intra-op threads; 1 measured fastest here
   // Probe 1 thread against torch_threads while training and keep the faster
-  // (rl/thread_tuner.h): more threads collapse when another process competes
+  // (rl/speed_tuner.h): more threads collapse when another process competes
   // for the cores.
   bool adapt_torch_threads = false;
   // Learn from the previous batch on a second thread while the next one is
@@ -196,14 +198,15 @@ struct PpoOptions {
       "LibTorch intra-op threads");
     v("adapt_torch_threads", self.adapt_torch_threads, Range::Any(),
       "probe 1 thread against torch_threads while training and keep the "
-      "faster");
+      "faster (re-probed as the load changes)");
     v("overlap_update", self.overlap_update, Range::Any(),
       "learn from the previous batch on a second thread while collecting "
       "the next");
     v("training_precision", self.training_precision, Range::Any(),
       "arithmetic of the networks' matrix products in collection and "
       "update: fp32, bf16 (float32 weights and losses), or auto (bf16 "
-      "where a probe at start-up times it at least 1.2x fp32, else fp32)");
+      "where a probe at start-up times it at least 1.2x fp32, else fp32; "
+      "then both re-measured in training iterations as the load changes)");
     v("collection", self.collection, Range::Any(),
       "batched: one forward pass for all environments per step, then their "
       "physics on the env threads; per_thread: each env thread acts for and "

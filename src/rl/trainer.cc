@@ -21,7 +21,7 @@
 #include "rl/collector.h"
 #include "rl/hard_views.h"
 #include "rl/ppo.h"
-#include "rl/thread_tuner.h"
+#include "rl/speed_tuner.h"
 
 namespace m2d {
 namespace {
@@ -54,8 +54,19 @@ struct Trainer::State {
   torch::Generator generator;
   SimState state_template;
   CheckpointCounters counters;
+  // How the networks run this iteration: LibTorch's threads and the
+  // arithmetic (never kAuto here). With agent.adapt_torch_threads or
+  // training_precision auto, the tuner picks among `network_settings`
+  // (threads x precision; [0] the start) by measured speed.
+  struct NetworkSetting {
+    int torch_threads = 1;
+    TrainingPrecision precision = TrainingPrecision::kFp32;
+  };
   int torch_threads = 1;
-  std::unique_ptr<ThreadTuner> thread_tuner;  // with adapt_torch_threads
+  TrainingPrecision precision = TrainingPrecision::kFp32;
+  std::vector<NetworkSetting> network_settings;
+  int network_setting = 0;  // this iteration's, an index of the above
+  std::unique_ptr<SpeedTuner> speed_tuner;
 
   // Adam's rate, kept in its parameter groups (and so in checkpoints).
   double LearningRate() const {
@@ -74,16 +85,19 @@ struct Trainer::State {
   ActorCritic behavior{nullptr};
 
   PpoLosses Learn(const RolloutStorage& batch) {
-    return PpoUpdate(model, *optimizer, batch, config.ppo, generator);
+    PpoOptions options = config.ppo;
+    options.training_precision = precision;
+    return PpoUpdate(model, *optimizer, batch, options, generator);
   }
   struct Step;
   Step CollectThenLearn(RolloutStorage& batch);
   Step CollectWhileLearning(RolloutStorage& next,
                             const RolloutStorage* previous);
-  void ChooseThreads();
-  void RecordThreads(const Step& step);
+  void SetUpSpeedTuner();
+  void ChooseNetworkSetting();
+  void RecordNetworkSetting(const Step& step);
   torch::Tensor CriticValue(const torch::Tensor& raw) {
-    PrecisionScope precision(config.ppo.training_precision);
+    PrecisionScope scope(precision);
     return model->Value(Normalized(raw)).to(torch::kFloat);
   }
   void Save() {
@@ -141,11 +155,6 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   // run LibTorch on one thread.
   s.torch_threads = config.ppo.overlap_update ? 1 : config.ppo.torch_threads;
   at::set_num_threads(s.torch_threads);
-  if (config.ppo.adapt_torch_threads) {
-    ThreadTunerOptions tuner;
-    tuner.max_threads = config.ppo.torch_threads;
-    s.thread_tuner = std::make_unique<ThreadTuner>(tuner);
-  }
   torch::manual_seed(run.seed);
   s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
 
@@ -160,13 +169,14 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.initial_states = task.initial_states;
   spdlog::info("{} initial-state buffers for {} views",
                s.initial_states->num_buffers(), s.reference->views().size());
+  s.precision = ResolvePrecision(config.ppo.training_precision);
   if (config.ppo.training_precision == TrainingPrecision::kAuto) {
     spdlog::info(
-        "training precision auto: {} (bf16 measured at {:.2f}x fp32; "
-        "bf16 from {:.1f}x)",
-        SettingName(ResolvePrecision(config.ppo.training_precision)),
-        Bf16Speedup(), kAutoBf16MinSpeedup);
+        "training precision auto: {} to start (bf16 measured at {:.2f}x "
+        "fp32; bf16 from {:.1f}x); re-measured while training",
+        SettingName(s.precision), Bf16Speedup(), kAutoBf16MinSpeedup);
   }
+  s.SetUpSpeedTuner();
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
@@ -242,6 +252,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   }
   s.collector =
       std::make_unique<RolloutCollector>(*s.envs, config.ppo, noise_generator);
+  s.collector->set_precision(s.precision);
   WriteFileAtomic(run.run_dir + "/config.yaml", TrainConfigToYaml(config));
 }
 
@@ -302,26 +313,57 @@ Trainer::State::Step Trainer::State::CollectWhileLearning(
   return step;
 }
 
-void Trainer::State::ChooseThreads() {
-  if (!thread_tuner) return;
-  const int threads = thread_tuner->ThreadsForNextIteration();
-  if (threads != torch_threads) {
-    torch_threads = threads;
-    at::set_num_threads(threads);
+void Trainer::State::SetUpSpeedTuner() {
+  // The candidates: the configured threads, and 1 with
+  // adapt_torch_threads; the start-up precision, and the other with auto.
+  // Ordered so that the first probe is a thread count (the common change).
+  std::vector<int> thread_counts = {torch_threads};
+  if (config.ppo.adapt_torch_threads) thread_counts.push_back(1);
+  std::vector<TrainingPrecision> precisions = {precision};
+  if (config.ppo.training_precision == TrainingPrecision::kAuto) {
+    precisions.push_back(precision == TrainingPrecision::kBf16
+                             ? TrainingPrecision::kFp32
+                             : TrainingPrecision::kBf16);
+  }
+  network_settings.clear();
+  for (TrainingPrecision p : precisions) {
+    for (int threads : thread_counts) network_settings.push_back({threads, p});
+  }
+  if (network_settings.size() < 2) return;
+  SpeedTunerOptions options;
+  options.num_candidates = static_cast<int>(network_settings.size());
+  speed_tuner = std::make_unique<SpeedTuner>(options);
+}
+
+void Trainer::State::ChooseNetworkSetting() {
+  if (!speed_tuner) return;
+  network_setting = speed_tuner->CandidateForNextIteration();
+  const NetworkSetting& setting = network_settings[network_setting];
+  if (setting.torch_threads != torch_threads) {
+    torch_threads = setting.torch_threads;
+    at::set_num_threads(torch_threads);
+  }
+  if (setting.precision != precision) {
+    // With overlap_update the batch learned next was collected in the
+    // other arithmetic: that one update's first ratios carry bfloat16's
+    // rounding (about KL 0.004; docs/training.md, "Throughput", item 5).
+    precision = setting.precision;
+    collector->set_precision(precision);
   }
 }
 
-void Trainer::State::RecordThreads(const Step& step) {
-  if (!thread_tuner) return;
-  const int previous = thread_tuner->chosen_threads();
-  const double previous_s = thread_tuner->chosen_seconds_per_sample();
-  if (thread_tuner->Record(torch_threads, (step.collect_s + step.update_s) /
-                                              config.ppo.batch_size())) {
+void Trainer::State::RecordNetworkSetting(const Step& step) {
+  if (!speed_tuner) return;
+  const NetworkSetting previous = network_settings[speed_tuner->chosen()];
+  const double previous_s = speed_tuner->chosen_seconds_per_sample();
+  if (speed_tuner->Record(network_setting, (step.collect_s + step.update_s) /
+                                               config.ppo.batch_size())) {
     spdlog::info(
-        "LibTorch threads {} -> {}: {:.0f} -> {:.0f} samples/s (collect + "
-        "update)",
-        previous, torch_threads, 1.0 / previous_s,
-        1.0 / thread_tuner->chosen_seconds_per_sample());
+        "networks {} thread(s) {} -> {} thread(s) {}: {:.0f} -> {:.0f} "
+        "samples/s (collect + update)",
+        previous.torch_threads, SettingName(previous.precision), torch_threads,
+        SettingName(precision), 1.0 / previous_s,
+        1.0 / speed_tuner->chosen_seconds_per_sample());
   }
 }
 
@@ -333,7 +375,8 @@ TrainProgress MakeProgress(const CheckpointCounters& counters,
                            const Trainer::IterationTiming& timing,
                            const std::vector<FinishedEpisode>& finished,
                            const PpoLosses& losses, double learning_rate,
-                           int torch_threads, int batch_size) {
+                           int torch_threads, TrainingPrecision precision,
+                           int batch_size) {
   TrainProgress progress;
   progress.iteration = counters.iteration;
   progress.samples = counters.samples;
@@ -343,6 +386,7 @@ TrainProgress MakeProgress(const CheckpointCounters& counters,
   progress.update_s = timing.update_s;
   progress.asi_s = timing.asi_s;
   progress.torch_threads = torch_threads;
+  progress.bf16 = precision == TrainingPrecision::kBf16;
   if (!finished.empty()) {
     double returns = 0, lengths = 0, successes = 0, errors = 0;
     for (const FinishedEpisode& episode : finished) {
@@ -396,8 +440,8 @@ TrainSummary Trainer::Run(
     if (max_iterations > 0 && summary.iterations_run >= max_iterations) break;
     const Clock::time_point start = Clock::now();
     const double learning_rate = s.LearningRate();
-    // 0. LibTorch's thread count (adaptive: the tuner's pick or probe).
-    s.ChooseThreads();
+    // 0. How the networks run (adaptive: the tuner's pick or probe).
+    s.ChooseNetworkSetting();
     // 1-2. Collect a batch of experience and learn from it (overlapped:
     // learn from the previous batch while collecting the next).
     State::Step step;
@@ -414,7 +458,7 @@ TrainSummary Trainer::Run(
       s.SetLearningRate(
           AdaptLearningRate(learning_rate, step.losses.approx_kl, config.ppo));
     }
-    s.RecordThreads(step);
+    s.RecordNetworkSetting(step);
     // 3. Refresh the initial-state buffers (ASI).
     const Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;
@@ -444,9 +488,9 @@ TrainSummary Trainer::Run(
                            SecondsSince(asi_start)};
     s.counters.samples += config.ppo.batch_size();
     s.counters.wall_time_s += timing.iteration_s;
-    const TrainProgress progress =
-        MakeProgress(s.counters, timing, step.finished, step.losses,
-                     learning_rate, s.torch_threads, config.ppo.batch_size());
+    const TrainProgress progress = MakeProgress(
+        s.counters, timing, step.finished, step.losses, learning_rate,
+        s.torch_threads, s.precision, config.ppo.batch_size());
     log.Append(progress);
     if (on_progress) on_progress(progress);
     summary.last = progress;

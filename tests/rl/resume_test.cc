@@ -241,7 +241,7 @@ TEST(Resume, RowsOfAnOlderLogGetEmptyCellsForNewColumns) {
   const std::string dir = testing::TempDir("resume_old_log");
   const TrainConfig config = TinyConfig(walk_path, dir);
   TrainIterations(config, /*resume=*/false, 2);
-  // Rewrite the log as the trainer wrote it before the last three columns.
+  // Rewrite the log as the trainer wrote it before the last four columns.
   const std::string log_path = config.run.run_dir + "/train_log.csv";
   std::vector<std::string> lines;
   {
@@ -265,17 +265,17 @@ TEST(Resume, RowsOfAnOlderLogGetEmptyCellsForNewColumns) {
   std::ifstream in(log_path);
   std::string header, row;
   std::getline(in, header);
-  EXPECT_NE(header.find(",approx_kl,clip_fraction,torch_threads"),
+  EXPECT_NE(header.find(",approx_kl,clip_fraction,torch_threads,precision"),
             std::string::npos)
       << header;
   std::vector<std::string> rows;
   while (std::getline(in, row)) rows.push_back(row);
   ASSERT_EQ(rows.size(), 3u);
   for (const std::string& r : rows)
-    EXPECT_EQ(std::count(r.begin(), r.end(), ','), 14) << r;
+    EXPECT_EQ(std::count(r.begin(), r.end(), ','), 15) << r;
   // The old rows' new cells are empty; the new row fills them.
-  EXPECT_EQ(rows[0].substr(rows[0].size() - 3), ",,,");
-  EXPECT_EQ(rows[1].substr(rows[1].size() - 3), ",,,");
+  EXPECT_EQ(rows[0].substr(rows[0].size() - 4), ",,,,");
+  EXPECT_EQ(rows[1].substr(rows[1].size() - 4), ",,,,");
   EXPECT_NE(rows[2].back(), ',');
   fs::remove_all(dir);
 }
@@ -601,6 +601,40 @@ TEST(Resume, SurvivesKillsAtRandomMoments) {
   const std::vector<LogRow> log = ReadLog(config.run.run_dir);
   ASSERT_EQ(static_cast<int>(log.size()), last_iteration + 3);
   for (size_t i = 0; i < log.size(); ++i) EXPECT_EQ(log[i].iteration, i + 1);
+  fs::remove_all(dir);
+}
+
+// With training_precision auto the start-up probe picks the first
+// precision; the trainer then measures the other in real iterations (the
+// probe answers only for the load at start-up), and the log says which
+// arithmetic each iteration ran in.
+TEST(Trainer, AutoPrecisionIsMeasuredAgainWhileTraining) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("trainer_auto_precision");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.training_precision = TrainingPrecision::kAuto;
+  config.Validate();
+  const bool start_bf16 =
+      ResolvePrecision(TrainingPrecision::kAuto) == TrainingPrecision::kBf16;
+
+  // The first probe comes after 4 iterations of the starting pick (sooner
+  // if an iteration is much slower than the others).
+  RunResult run = TrainIterations(config, /*resume=*/false, 6);
+  ASSERT_EQ(run.progress.size(), 6u);
+  EXPECT_EQ(run.progress[0].bf16, start_bf16);
+  int other = 0;
+  for (const TrainProgress& p : run.progress) other += p.bf16 != start_bf16;
+  EXPECT_GE(other, 1);
+  EXPECT_LE(other, 5);
+
+  std::ifstream in(config.run.run_dir + "/train_log.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.substr(line.size() - 10), ",precision") << line;
+  for (const TrainProgress& p : run.progress) {
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_EQ(line.substr(line.size() - 5), p.bf16 ? ",bf16" : ",fp32") << line;
+  }
   fs::remove_all(dir);
 }
 
