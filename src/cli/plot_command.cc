@@ -15,7 +15,7 @@ struct PlotArgs {
 };
 
 int RunPlot(const PlotArgs& args) {
-  std::vector<TrainingLog> logs;
+  std::vector<TrainingCurves> logs;
   for (const std::string& path : args.logs)
     logs.push_back(ReadTrainingLog(path));
   const PlotFiles files =

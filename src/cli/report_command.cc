@@ -27,7 +27,7 @@ int RunReport(const ReportArgs& args) {
   // Curves from the logs are drawn into a scratch folder and embedded.
   ScopedTempFolder scratch("mimic2d_report");
   if (!args.logs.empty()) {
-    std::vector<TrainingLog> logs;
+    std::vector<TrainingCurves> logs;
     for (const std::string& path : args.logs) {
       logs.push_back(ReadTrainingLog(path));
     }

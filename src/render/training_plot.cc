@@ -72,9 +72,9 @@ std::string Quote(const std::string& text) {
 }
 
 // Seconds, minutes or hours, whichever keeps the axis readable.
-TimeAxis ChooseTimeAxis(const std::vector<TrainingLog>& logs) {
+TimeAxis ChooseTimeAxis(const std::vector<TrainingCurves>& logs) {
   double longest_s = 0.0;
-  for (const TrainingLog& log : logs) {
+  for (const TrainingCurves& log : logs) {
     for (double t : log.columns.at("wall_time_s")) {
       if (std::isfinite(t)) longest_s = std::max(longest_s, t);
     }
@@ -85,11 +85,11 @@ TimeAxis ChooseTimeAxis(const std::vector<TrainingLog>& logs) {
 }
 
 // Legend names: file stems, prefixed with their folder where two clash.
-std::vector<std::string> LegendNames(const std::vector<TrainingLog>& logs) {
+std::vector<std::string> LegendNames(const std::vector<TrainingCurves>& logs) {
   std::vector<std::string> names;
   std::multiset<std::string> seen;
-  for (const TrainingLog& log : logs) seen.insert(log.name);
-  for (const TrainingLog& log : logs) {
+  for (const TrainingCurves& log : logs) seen.insert(log.name);
+  for (const TrainingCurves& log : logs) {
     std::string name = log.name;
     if (seen.count(name) > 1) {
       const std::string folder = std::filesystem::path(log.source_path)
@@ -105,7 +105,7 @@ std::vector<std::string> LegendNames(const std::vector<TrainingLog>& logs) {
 
 // Writes the finite points of one metric: samples, time, value. Returns the
 // number of points.
-int WriteSeries(const TrainingLog& log, const char* column,
+int WriteSeries(const TrainingCurves& log, const char* column,
                 const TimeAxis& time, const std::string& path) {
   std::ofstream out(path);
   out.precision(12);
@@ -178,13 +178,13 @@ void RunGnuplot(const std::string& script_path, const PlotOptions& options) {
 
 }  // namespace
 
-int TrainingLog::num_rows() const {
+int TrainingCurves::num_rows() const {
   return columns.empty() ? 0 : static_cast<int>(columns.begin()->second.size());
 }
 
-TrainingLog ReadTrainingLog(const std::string& csv_path) {
+TrainingCurves ReadTrainingLog(const std::string& csv_path) {
   std::istringstream text(ReadFileText(csv_path));
-  TrainingLog log;
+  TrainingCurves log;
   log.source_path = csv_path;
   log.name = std::filesystem::path(csv_path).stem().string();
   std::string line;
@@ -232,7 +232,7 @@ void PlotOptions::Validate() const {
   }
 }
 
-PlotFiles PlotTrainingCurves(const std::vector<TrainingLog>& logs,
+PlotFiles PlotTrainingCurves(const std::vector<TrainingCurves>& logs,
                              const std::string& output_folder,
                              const PlotOptions& options) {
   // Outline: one data file per run and metric (finite points only), one

@@ -14,9 +14,10 @@ namespace m2d {
 inline constexpr const char* kTrainingLogRequiredColumns[] = {
     "samples", "wall_time_s", "samples_per_s", "mean_return", "succ", "e2d_px"};
 
-// One run's training log (CSV with a header row). Every column is numeric;
-// an empty cell or "nan" is a missing value (e.g. Succ between evaluations).
-struct TrainingLog {
+// One run's training log as read for plotting (CSV with a header row; not
+// rl's TrainingLog, which writes it). Every column is numeric; an empty
+// cell or "nan" is a missing value (e.g. Succ between evaluations).
+struct TrainingCurves {
   std::string source_path;
   std::string name;                                    // legend label
   std::map<std::string, std::vector<double>> columns;  // one value per row
@@ -25,7 +26,7 @@ struct TrainingLog {
 
 // Reads and checks a log; InputError naming the file, the line and the
 // column of the first problem (missing column, non-number, ragged row).
-TrainingLog ReadTrainingLog(const std::string& csv_path);
+TrainingCurves ReadTrainingLog(const std::string& csv_path);
 
 struct PlotOptions {
   int width_px = 1400;  // size of each PNG
@@ -43,7 +44,7 @@ struct PlotFiles {
 // pngcairo terminal into `output_folder`/curves_vs_samples.png and
 // curves_vs_wall_time.png (written atomically). Throws std::runtime_error
 // with gnuplot's message when it fails.
-PlotFiles PlotTrainingCurves(const std::vector<TrainingLog>& logs,
+PlotFiles PlotTrainingCurves(const std::vector<TrainingCurves>& logs,
                              const std::string& output_folder,
                              const PlotOptions& options);
 

@@ -15,7 +15,7 @@ constexpr char kHeader[] =
     "iteration,samples,wall_time_s,samples_per_s,mean_return,mean_episode_"
     "length,succ,e2d_px,"
     "policy_loss,value_loss,entropy,learning_rate,approx_kl,clip_fraction,"
-    "torch_threads,precision";
+    "torch_threads,bf16";
 
 std::vector<std::string> SplitFields(const std::string& row) {
   std::vector<std::string> fields;
@@ -78,7 +78,7 @@ void TrainingLog::Append(const TrainProgress& p) {
        << p.mean_episode_length << ',' << p.succ << ',' << p.e2d_px << ','
        << p.policy_loss << ',' << p.value_loss << ',' << p.entropy << ','
        << p.learning_rate << ',' << p.approx_kl << ',' << p.clip_fraction << ','
-       << p.torch_threads << ',' << (p.bf16 ? "bf16" : "fp32") << '\n';
+       << p.torch_threads << ',' << (p.bf16 ? 1 : 0) << '\n';
   out_.flush();
   if (!out_) {
     throw InputError(path_,

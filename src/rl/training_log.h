@@ -26,7 +26,8 @@ struct TrainProgress {
   double learning_rate = 0.0;
   double collect_s = 0.0, update_s = 0.0, asi_s = 0.0;  // time split
   int torch_threads = 1;  // LibTorch threads this iteration ran with
-  bool bf16 = false;      // and whether its networks ran in bfloat16
+  bool bf16 = false;      // and whether its networks ran in bfloat16 (the
+                          // log's 0/1: every cell of the log is a number)
 };
 
 // What a resumed run may need from the log's last kept row (-1: absent).

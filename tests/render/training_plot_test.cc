@@ -45,7 +45,7 @@ int CountColor(const RgbImage& image, Rgb color) {
 TEST(TrainingPlot, ReadsTheTrainerSchemaWithMissingValues) {
   const std::string path = testing::TempDir("plot_read") + "/train.csv";
   WriteFileAtomic(path, SampleLog(20, 1500.0));
-  const TrainingLog log = ReadTrainingLog(path);
+  const TrainingCurves log = ReadTrainingLog(path);
   EXPECT_EQ(log.name, "train");
   EXPECT_EQ(log.num_rows(), 20);
   EXPECT_EQ(log.columns.size(), 12u);
@@ -58,7 +58,7 @@ TEST(TrainingPlot, DrawsBothFiguresAsPngs) {
   const std::string folder = testing::TempDir("plot_draw");
   WriteFileAtomic(folder + "/a/train.csv", SampleLog(40, 1500.0));
   WriteFileAtomic(folder + "/b/train.csv", SampleLog(25, 900.0));
-  const std::vector<TrainingLog> logs = {
+  const std::vector<TrainingCurves> logs = {
       ReadTrainingLog(folder + "/a/train.csv"),
       ReadTrainingLog(folder + "/b/train.csv")};
   PlotOptions options;

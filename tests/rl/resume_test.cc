@@ -23,6 +23,7 @@
 #include "env/task.h"
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
+#include "render/training_plot.h"
 #include "rl/checkpoint.h"
 #include "rl/trainer.h"
 #include "sim/simulation.h"
@@ -265,7 +266,7 @@ TEST(Resume, RowsOfAnOlderLogGetEmptyCellsForNewColumns) {
   std::ifstream in(log_path);
   std::string header, row;
   std::getline(in, header);
-  EXPECT_NE(header.find(",approx_kl,clip_fraction,torch_threads,precision"),
+  EXPECT_NE(header.find(",approx_kl,clip_fraction,torch_threads,bf16"),
             std::string::npos)
       << header;
   std::vector<std::string> rows;
@@ -630,11 +631,16 @@ TEST(Trainer, AutoPrecisionIsMeasuredAgainWhileTraining) {
   std::ifstream in(config.run.run_dir + "/train_log.csv");
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line.substr(line.size() - 10), ",precision") << line;
+  EXPECT_EQ(line.substr(line.size() - 5), ",bf16") << line;
   for (const TrainProgress& p : run.progress) {
     ASSERT_TRUE(std::getline(in, line));
-    EXPECT_EQ(line.substr(line.size() - 5), p.bf16 ? ",bf16" : ",fp32") << line;
+    EXPECT_EQ(line.substr(line.size() - 2), p.bf16 ? ",1" : ",0") << line;
   }
+  // `plot` and `report --log` read it (every cell a number).
+  const TrainingCurves curves =
+      ReadTrainingLog(config.run.run_dir + "/train_log.csv");
+  EXPECT_EQ(curves.num_rows(), 6);
+  EXPECT_EQ(curves.columns.count("bf16"), 1u);
   fs::remove_all(dir);
 }
 
