@@ -54,19 +54,20 @@ struct Trainer::State {
   torch::Generator generator;
   SimState state_template;
   CheckpointCounters counters;
-  // How the networks run this iteration: LibTorch's threads and the
-  // arithmetic (never kAuto here). With agent.adapt_torch_threads or
-  // training_precision auto, the tuner picks among `network_settings`
-  // (threads x precision; [0] the start) by measured speed.
+  // How the networks run: LibTorch's threads and the arithmetic (never
+  // kAuto here). With agent.adapt_torch_threads or training_precision auto,
+  // the tuner picks among `network_settings` (threads x precision; [0] the
+  // start) by measured speed.
   struct NetworkSetting {
     int torch_threads = 1;
     TrainingPrecision precision = TrainingPrecision::kFp32;
   };
-  int torch_threads = 1;
-  TrainingPrecision precision = TrainingPrecision::kFp32;
   std::vector<NetworkSetting> network_settings;
   int network_setting = 0;  // this iteration's, an index of the above
   std::unique_ptr<SpeedTuner> speed_tuner;
+  const NetworkSetting& Current() const {
+    return network_settings[network_setting];
+  }
 
   // Adam's rate, kept in its parameter groups (and so in checkpoints).
   double LearningRate() const {
@@ -86,18 +87,19 @@ struct Trainer::State {
 
   PpoLosses Learn(const RolloutStorage& batch) {
     PpoOptions options = config.ppo;
-    options.training_precision = precision;
+    options.training_precision = Current().precision;
     return PpoUpdate(model, *optimizer, batch, options, generator);
   }
   struct Step;
   Step CollectThenLearn(RolloutStorage& batch);
   Step CollectWhileLearning(RolloutStorage& next,
                             const RolloutStorage* previous);
-  void SetUpSpeedTuner();
+  void SetUpNetworkSettings(int start_threads,
+                            TrainingPrecision start_precision);
   void ChooseNetworkSetting();
   void RecordNetworkSetting(const Step& step);
   torch::Tensor CriticValue(const torch::Tensor& raw) {
-    PrecisionScope scope(precision);
+    PrecisionScope scope(Current().precision);
     return model->Value(Normalized(raw)).to(torch::kFloat);
   }
   void Save() {
@@ -153,8 +155,9 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.checkpoint_path = run.run_dir + "/checkpoint.pt";
   // With overlap, collection (this thread) and update (a second one) each
   // run LibTorch on one thread.
-  s.torch_threads = config.ppo.overlap_update ? 1 : config.ppo.torch_threads;
-  at::set_num_threads(s.torch_threads);
+  const int start_threads =
+      config.ppo.overlap_update ? 1 : config.ppo.torch_threads;
+  at::set_num_threads(start_threads);
   torch::manual_seed(run.seed);
   s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
 
@@ -169,14 +172,15 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.initial_states = task.initial_states;
   spdlog::info("{} initial-state buffers for {} views",
                s.initial_states->num_buffers(), s.reference->views().size());
-  s.precision = ResolvePrecision(config.ppo.training_precision);
+  const TrainingPrecision start_precision =
+      ResolvePrecision(config.ppo.training_precision);
   if (config.ppo.training_precision == TrainingPrecision::kAuto) {
     spdlog::info(
         "training precision auto: {} to start (bf16 measured at {:.2f}x "
         "fp32; bf16 from {:.1f}x); re-measured while training",
-        SettingName(s.precision), Bf16Speedup(), kAutoBf16MinSpeedup);
+        SettingName(start_precision), Bf16Speedup(), kAutoBf16MinSpeedup);
   }
-  s.SetUpSpeedTuner();
+  s.SetUpNetworkSettings(start_threads, start_precision);
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
                                     run.env_threads);
@@ -252,7 +256,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   }
   s.collector =
       std::make_unique<RolloutCollector>(*s.envs, config.ppo, noise_generator);
-  s.collector->set_precision(s.precision);
+  s.collector->set_precision(start_precision);
   WriteFileAtomic(run.run_dir + "/config.yaml", TrainConfigToYaml(config));
 }
 
@@ -313,19 +317,21 @@ Trainer::State::Step Trainer::State::CollectWhileLearning(
   return step;
 }
 
-void Trainer::State::SetUpSpeedTuner() {
-  // The candidates: the configured threads, and 1 with
-  // adapt_torch_threads; the start-up precision, and the other with auto.
-  // Ordered so that the first probe is a thread count (the common change).
-  std::vector<int> thread_counts = {torch_threads};
+void Trainer::State::SetUpNetworkSettings(int start_threads,
+                                          TrainingPrecision start_precision) {
+  // The candidates: the start's threads, and 1 with adapt_torch_threads;
+  // the start-up precision, and the other with auto. Ordered so that the
+  // first probe is a thread count (the common change).
+  std::vector<int> thread_counts = {start_threads};
   if (config.ppo.adapt_torch_threads) thread_counts.push_back(1);
-  std::vector<TrainingPrecision> precisions = {precision};
+  std::vector<TrainingPrecision> precisions = {start_precision};
   if (config.ppo.training_precision == TrainingPrecision::kAuto) {
-    precisions.push_back(precision == TrainingPrecision::kBf16
+    precisions.push_back(start_precision == TrainingPrecision::kBf16
                              ? TrainingPrecision::kFp32
                              : TrainingPrecision::kBf16);
   }
   network_settings.clear();
+  network_setting = 0;
   for (TrainingPrecision p : precisions) {
     for (int threads : thread_counts) network_settings.push_back({threads, p});
   }
@@ -337,18 +343,15 @@ void Trainer::State::SetUpSpeedTuner() {
 
 void Trainer::State::ChooseNetworkSetting() {
   if (!speed_tuner) return;
+  const NetworkSetting before = Current();
   network_setting = speed_tuner->CandidateForNextIteration();
-  const NetworkSetting& setting = network_settings[network_setting];
-  if (setting.torch_threads != torch_threads) {
-    torch_threads = setting.torch_threads;
-    at::set_num_threads(torch_threads);
-  }
-  if (setting.precision != precision) {
+  if (Current().torch_threads != before.torch_threads)
+    at::set_num_threads(Current().torch_threads);
+  if (Current().precision != before.precision) {
     // With overlap_update the batch learned next was collected in the
     // other arithmetic: that one update's first ratios carry bfloat16's
     // rounding (about KL 0.004; docs/training.md, "Throughput", item 5).
-    precision = setting.precision;
-    collector->set_precision(precision);
+    collector->set_precision(Current().precision);
   }
 }
 
@@ -361,9 +364,9 @@ void Trainer::State::RecordNetworkSetting(const Step& step) {
     spdlog::info(
         "networks {} thread(s) {} -> {} thread(s) {}: {:.0f} -> {:.0f} "
         "samples/s (collect + update)",
-        previous.torch_threads, SettingName(previous.precision), torch_threads,
-        SettingName(precision), 1.0 / previous_s,
-        1.0 / speed_tuner->chosen_seconds_per_sample());
+        previous.torch_threads, SettingName(previous.precision),
+        Current().torch_threads, SettingName(Current().precision),
+        1.0 / previous_s, 1.0 / speed_tuner->chosen_seconds_per_sample());
   }
 }
 
@@ -488,9 +491,10 @@ TrainSummary Trainer::Run(
                            SecondsSince(asi_start)};
     s.counters.samples += config.ppo.batch_size();
     s.counters.wall_time_s += timing.iteration_s;
-    const TrainProgress progress = MakeProgress(
-        s.counters, timing, step.finished, step.losses, learning_rate,
-        s.torch_threads, s.precision, config.ppo.batch_size());
+    const TrainProgress progress =
+        MakeProgress(s.counters, timing, step.finished, step.losses,
+                     learning_rate, s.Current().torch_threads,
+                     s.Current().precision, config.ppo.batch_size());
     log.Append(progress);
     if (on_progress) on_progress(progress);
     summary.last = progress;
