@@ -174,23 +174,11 @@ double TimeMlpStep(TrainingPrecision precision, int repeats) {
 
 }  // namespace
 
-double Bf16Speedup() {
+const Bf16Support& ProbeBf16() {
   // Once per process, on the LibTorch threads of the first caller (the
-  // trainer resolves before it collects). One untimed pass each warms
-  // oneDNN's kernels and autocast's casts.
-  static const double speedup = [] {
-    TimeMlpStep(TrainingPrecision::kFp32, 1);
-    TimeMlpStep(TrainingPrecision::kBf16, 1);
-    return TimeMlpStep(TrainingPrecision::kFp32, 3) /
-           TimeMlpStep(TrainingPrecision::kBf16, 3);
-  }();
-  return speedup;
-}
-
-TrainingPrecision ResolvePrecision(TrainingPrecision precision) {
-  if (precision != TrainingPrecision::kAuto) return precision;
-  return Bf16Speedup() >= kAutoBf16MinSpeedup ? TrainingPrecision::kBf16
-                                              : TrainingPrecision::kFp32;
+  // trainer resolves before it collects).
+  static const Bf16Support support = MeasureBf16Support(TimeMlpStep);
+  return support;
 }
 
 PrecisionScope::PrecisionScope(TrainingPrecision precision)

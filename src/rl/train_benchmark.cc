@@ -111,6 +111,14 @@ void RunTrainBenchmark(const TrainBenchmarkOptions& options) {
   // bound.
   options.Validate();
   TrainConfig config = LoadTrainConfig(options.config_path);
+  std::vector<TrainingPrecision> precisions = options.precisions;
+  if (precisions.empty())
+    precisions = {ResolvePrecision(config.ppo.training_precision)};
+  for (TrainingPrecision precision : precisions) {
+    RequirePrecisionRuns(precision, options.precisions.empty()
+                                        ? "agent.training_precision"
+                                        : "--precision");
+  }
   std::printf(
       "bench train: %s, %d envs x %d steps = %d samples per iteration, %d "
       "env threads, BLAS: %s\n",
@@ -124,9 +132,6 @@ void RunTrainBenchmark(const TrainBenchmarkOptions& options) {
       "simulation-only bound: %.0f samples/s (the same %d environments "
       "stepped with no policy, %d env threads)\n\n",
       bound, config.ppo.num_envs, config.run.env_threads);
-  std::vector<TrainingPrecision> precisions = options.precisions;
-  if (precisions.empty())
-    precisions = {ResolvePrecision(config.ppo.training_precision)};
   std::vector<CollectionMode> collections = options.collections;
   if (collections.empty()) collections = {config.ppo.collection};
   std::vector<Setting> settings;

@@ -48,6 +48,42 @@ bool ParseSetting(const std::string& text, TrainingPrecision* precision) {
                             precision);
 }
 
+Bf16Support MeasureBf16Support(
+    const std::function<double(TrainingPrecision, int)>& time_step) {
+  Bf16Support support;
+  // The untimed steps warm oneDNN's kernels and autocast's casts; the bf16
+  // ones are where oneDNN refuses, if it does.
+  time_step(TrainingPrecision::kFp32, 1);
+  try {
+    time_step(TrainingPrecision::kBf16, 1);
+    const double fp32_s = time_step(TrainingPrecision::kFp32, 3);
+    support.speedup = fp32_s / time_step(TrainingPrecision::kBf16, 3);
+    support.runs = true;
+  } catch (const std::exception& e) {
+    support.error = e.what();
+    // LibTorch appends a C++ backtrace to its messages: keep the first line.
+    support.error = support.error.substr(0, support.error.find('\n'));
+  }
+  return support;
+}
+
+TrainingPrecision ResolvePrecision(TrainingPrecision precision) {
+  if (precision != TrainingPrecision::kAuto) return precision;
+  const Bf16Support& bf16 = ProbeBf16();
+  return bf16.runs && bf16.speedup >= kAutoBf16MinSpeedup
+             ? TrainingPrecision::kBf16
+             : TrainingPrecision::kFp32;
+}
+
+void RequirePrecisionRuns(TrainingPrecision precision,
+                          const std::string& setting) {
+  if (precision != TrainingPrecision::kBf16) return;
+  const Bf16Support& bf16 = ProbeBf16();
+  if (bf16.runs) return;
+  throw ConfigError(setting + ": bf16 does not run on this CPU and LibTorch (" +
+                    bf16.error + "); use fp32, or auto to choose");
+}
+
 const char* SettingName(CollectionMode mode) {
   return mode == CollectionMode::kPerThread ? "per_thread" : "batched";
 }

@@ -5,6 +5,7 @@
 #define MIMIC2D_RL_TRAIN_CONFIG_H_
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -98,13 +99,32 @@ bool ParseSetting(const std::string& text, TrainingPrecision* precision);
 inline std::string SettingChoices(TrainingPrecision) {
   return "fp32, bf16, auto";
 }
-// The precision that runs on this CPU: kAuto resolved by Bf16Speedup.
-// Both are defined in rl/networks.cc (the probe needs LibTorch).
+// Whether bf16 runs here, and how fast against fp32. oneDNN can refuse
+// bf16 where LibTorch routes it there (ONEDNN_MAX_CPU_ISA below AVX-512 on
+// an AVX-512 CPU: "could not create a primitive descriptor iterator"); then
+// `auto` trains in fp32 and an explicit bf16 is a named error, instead of
+// the training dying on LibTorch's message.
+struct Bf16Support {
+  bool runs = false;
+  double speedup = 0.0;  // bf16 : fp32 speed; 0 when bf16 does not run
+  std::string error;     // LibTorch's message when bf16 does not run
+};
+// The support measured with `time_step(precision, repeats)` (seconds of the
+// fastest of `repeats` steps): one untimed step each, then the ratio of
+// the timed ones; a step that throws marks bf16 as not running.
+Bf16Support MeasureBf16Support(
+    const std::function<double(TrainingPrecision, int)>& time_step);
+// This CPU's support on the networks' arithmetic (forward + backward of a
+// policy-sized MLP on a 1024-row minibatch, best of 3 each), measured once
+// per process (0.27 s on a Zen 5). Defined in rl/networks.cc (LibTorch).
+const Bf16Support& ProbeBf16();
+// The precision that runs on this CPU: kAuto resolved by ProbeBf16 (bf16
+// when it runs at kAutoBf16MinSpeedup or faster); explicit ones as given.
 TrainingPrecision ResolvePrecision(TrainingPrecision precision);
-// This CPU's bf16 : fp32 speed on the networks' arithmetic (forward +
-// backward of a policy-sized MLP on a 1024-row minibatch, best of 3 each),
-// measured once per process (0.27 s on a Zen 5).
-double Bf16Speedup();
+// Throws ConfigError naming `setting` when `precision` is bf16 and bf16
+// does not run here (ProbeBf16).
+void RequirePrecisionRuns(TrainingPrecision precision,
+                          const std::string& setting);
 
 // How collection shares the env threads between acting and simulating.
 enum class CollectionMode {

@@ -143,6 +143,10 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   State& s = *state_;
   s.config = config;
   const RunOptions& run = config.run;
+  // Before anything is written: a bf16 that cannot run here is a setting
+  // error, not a crash at the first collection.
+  RequirePrecisionRuns(config.ppo.training_precision,
+                       "agent.training_precision");
   std::filesystem::create_directories(run.run_dir);
   // Temp files of a run killed mid-write (WriteFileAtomic's "<name>.tmp.
   // <pid>"), also of kept checkpoints: never a checkpoint, only disk space.
@@ -175,10 +179,16 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   const TrainingPrecision start_precision =
       ResolvePrecision(config.ppo.training_precision);
   if (config.ppo.training_precision == TrainingPrecision::kAuto) {
-    spdlog::info(
-        "training precision auto: {} to start (bf16 measured at {:.2f}x "
-        "fp32; bf16 from {:.1f}x); re-measured while training",
-        SettingName(start_precision), Bf16Speedup(), kAutoBf16MinSpeedup);
+    const Bf16Support& bf16 = ProbeBf16();
+    if (bf16.runs) {
+      spdlog::info(
+          "training precision auto: {} to start (bf16 measured at {:.2f}x "
+          "fp32; bf16 from {:.1f}x); re-measured while training",
+          SettingName(start_precision), bf16.speedup, kAutoBf16MinSpeedup);
+    } else {
+      spdlog::warn("training precision auto: fp32 (bf16 does not run here: {})",
+                   bf16.error);
+    }
   }
   s.SetUpNetworkSettings(start_threads, start_precision);
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
@@ -320,12 +330,13 @@ Trainer::State::Step Trainer::State::CollectWhileLearning(
 void Trainer::State::SetUpNetworkSettings(int start_threads,
                                           TrainingPrecision start_precision) {
   // The candidates: the start's threads, and 1 with adapt_torch_threads;
-  // the start-up precision, and the other with auto. Ordered so that the
-  // first probe is a thread count (the common change).
+  // the start-up precision, and the other with auto where bf16 runs.
+  // Ordered so that the first probe is a thread count (the common change).
   std::vector<int> thread_counts = {start_threads};
   if (config.ppo.adapt_torch_threads) thread_counts.push_back(1);
   std::vector<TrainingPrecision> precisions = {start_precision};
-  if (config.ppo.training_precision == TrainingPrecision::kAuto) {
+  if (config.ppo.training_precision == TrainingPrecision::kAuto &&
+      ProbeBf16().runs) {
     precisions.push_back(start_precision == TrainingPrecision::kBf16
                              ? TrainingPrecision::kFp32
                              : TrainingPrecision::kBf16);

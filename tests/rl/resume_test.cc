@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <random>
 #include <sstream>
@@ -17,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli/cli_test_util.h"
 #include "common/error.h"
 #include "common/file_io.h"
 #include "env/env_fixture.h"
@@ -641,6 +643,56 @@ TEST(Trainer, AutoPrecisionIsMeasuredAgainWhileTraining) {
       ReadTrainingLog(config.run.run_dir + "/train_log.csv");
   EXPECT_EQ(curves.num_rows(), 6);
   EXPECT_EQ(curves.columns.count("bf16"), 1u);
+  fs::remove_all(dir);
+}
+
+// Where oneDNN refuses bf16 (a user can cap it below AVX-512 with
+// ONEDNN_MAX_CPU_ISA; on an AVX-512 CPU LibTorch still routes bf16 there,
+// and training died on "could not create a primitive descriptor iterator"),
+// `auto` trains in fp32 and says why, and an explicit bf16 is a named
+// error. Child processes: oneDNN reads the cap once per process. Where
+// LibTorch does not route bf16 to oneDNN, both run.
+TEST(Trainer, AutoTrainsInFp32WhereBf16DoesNotRun) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("trainer_bf16_refused");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.training_precision = TrainingPrecision::kAuto;
+  config.run.total_samples = 6 * kBatch;
+  config.Validate();
+  WriteFileAtomic(dir + "/auto.yaml", TrainConfigToYaml(config));
+  const std::string capped_train =
+      "ONEDNN_MAX_CPU_ISA=AVX2 " + std::string(MIMIC2D_BINARY) + " train ";
+
+  const testing::CommandResult run =
+      testing::RunCommand(capped_train + dir + "/auto.yaml");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const bool refused =
+      run.output.find("fp32 (bf16 does not run here: ") != std::string::npos;
+  std::cout << "bf16 under ONEDNN_MAX_CPU_ISA=AVX2: "
+            << (refused ? "refused, trained in fp32" : "runs") << "\n";
+  const TrainingCurves curves =
+      ReadTrainingLog(config.run.run_dir + "/train_log.csv");
+  ASSERT_EQ(curves.num_rows(), 6);
+  if (refused) {
+    for (double bf16 : curves.columns.at("bf16")) EXPECT_EQ(bf16, 0.0);
+  }
+
+  config.ppo.training_precision = TrainingPrecision::kBf16;
+  config.run.run_dir = dir + "/run_bf16";
+  WriteFileAtomic(dir + "/bf16.yaml", TrainConfigToYaml(config));
+  const testing::CommandResult explicit_bf16 =
+      testing::RunCommand(capped_train + dir + "/bf16.yaml");
+  if (refused) {
+    EXPECT_EQ(explicit_bf16.exit_code, 2) << explicit_bf16.output;
+    EXPECT_NE(explicit_bf16.output.find(
+                  "agent.training_precision: bf16 does not run on this CPU "
+                  "and LibTorch ("),
+              std::string::npos)
+        << explicit_bf16.output;
+    EXPECT_FALSE(fs::exists(config.run.run_dir + "/checkpoint.pt"));
+  } else {
+    EXPECT_EQ(explicit_bf16.exit_code, 0) << explicit_bf16.output;
+  }
   fs::remove_all(dir);
 }
 

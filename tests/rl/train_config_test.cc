@@ -154,20 +154,60 @@ TEST(TrainConfig, AutoPrecisionFollowsTheMeasuredBf16Speedup) {
   TrainingPrecision precision = TrainingPrecision::kFp32;
   ASSERT_TRUE(ParseSetting("auto", &precision));
   EXPECT_EQ(precision, TrainingPrecision::kAuto);
-  // The probe times real passes: a positive, finite ratio, measured once.
-  const double speedup = Bf16Speedup();
-  EXPECT_GT(speedup, 0.0);
-  EXPECT_TRUE(std::isfinite(speedup));
-  EXPECT_EQ(Bf16Speedup(), speedup);
+  // The probe times real passes, once: where bf16 runs, a positive, finite
+  // ratio; where it does not, LibTorch's reason.
+  const Bf16Support& bf16 = ProbeBf16();
+  EXPECT_EQ(&ProbeBf16(), &bf16);
+  if (bf16.runs) {
+    EXPECT_GT(bf16.speedup, 0.0);
+    EXPECT_TRUE(std::isfinite(bf16.speedup));
+    EXPECT_NO_THROW(RequirePrecisionRuns(TrainingPrecision::kBf16, "x"));
+  } else {
+    EXPECT_EQ(bf16.speedup, 0.0);
+    EXPECT_FALSE(bf16.error.empty());
+    EXPECT_THROW(RequirePrecisionRuns(TrainingPrecision::kBf16, "x"),
+                 ConfigError);
+  }
   EXPECT_EQ(ResolvePrecision(TrainingPrecision::kAuto),
-            speedup >= kAutoBf16MinSpeedup ? TrainingPrecision::kBf16
-                                           : TrainingPrecision::kFp32);
+            bf16.runs && bf16.speedup >= kAutoBf16MinSpeedup
+                ? TrainingPrecision::kBf16
+                : TrainingPrecision::kFp32);
   // An explicit choice is kept whatever the CPU.
   EXPECT_EQ(ResolvePrecision(TrainingPrecision::kBf16),
             TrainingPrecision::kBf16);
   EXPECT_EQ(ResolvePrecision(TrainingPrecision::kFp32),
             TrainingPrecision::kFp32);
+  EXPECT_NO_THROW(RequirePrecisionRuns(TrainingPrecision::kFp32, "x"));
   EXPECT_STREQ(SettingName(TrainingPrecision::kAuto), "auto");
+}
+
+TEST(TrainConfig, Bf16ThatThrowsIsMeasuredAsNotRunning) {
+  // A CPU where oneDNN refuses bf16 (as under ONEDNN_MAX_CPU_ISA=AVX2 on an
+  // AVX-512 CPU): the probe's bf16 step throws LibTorch's error.
+  int fp32_steps = 0;
+  const Bf16Support refused =
+      MeasureBf16Support([&](TrainingPrecision precision, int) -> double {
+        if (precision == TrainingPrecision::kBf16) {
+          throw c10::Error(
+              "could not create a primitive descriptor iterator\n"
+              "Exception raised from ... (most recent call first)",
+              "backtrace");
+        }
+        ++fp32_steps;
+        return 1.0;
+      });
+  EXPECT_FALSE(refused.runs);
+  EXPECT_EQ(refused.speedup, 0.0);
+  EXPECT_EQ(refused.error, "could not create a primitive descriptor iterator");
+  EXPECT_EQ(fp32_steps, 1);
+  // Where it runs: the ratio of the timed steps.
+  const Bf16Support runs =
+      MeasureBf16Support([](TrainingPrecision precision, int) {
+        return precision == TrainingPrecision::kBf16 ? 0.5 : 1.0;
+      });
+  EXPECT_TRUE(runs.runs);
+  EXPECT_DOUBLE_EQ(runs.speedup, 2.0);
+  EXPECT_TRUE(runs.error.empty());
 }
 
 TEST(TrainConfig, ProbingThePrecisionLeavesTheSeededDrawsAlone) {
