@@ -25,8 +25,17 @@ std::string ReadFileText(const std::string& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw InputError(
-        path, std::string("cannot open file (") + std::strerror(errno) + ")");
+    const int error = errno;
+    std::string problem =
+        std::string("cannot open file (") + std::strerror(error) + ")";
+    // Paths in configs are read from the working directory (the shipped
+    // ones from the repository's root): say which, for a command started
+    // elsewhere.
+    if (error == ENOENT && std::filesystem::path(path).is_relative()) {
+      problem += "; relative paths are read from the working directory " +
+                 std::filesystem::current_path(ec).string();
+    }
+    throw InputError(path, problem);
   }
   std::ostringstream buffer;
   buffer << in.rdbuf();

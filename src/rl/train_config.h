@@ -215,7 +215,7 @@ struct PpoOptions {
     v("normalize_observations", self.normalize_observations, Range::Any(),
       "running mean/std of observations, saved in checkpoints");
     v("torch_threads", self.torch_threads, Range::Closed(1, 1024),
-      "LibTorch intra-op threads");
+      "LibTorch intra-op threads (capped at the CPUs this process may use)");
     v("adapt_torch_threads", self.adapt_torch_threads, Range::Any(),
       "probe 1 thread against torch_threads while training and keep the "
       "faster (re-probed as the load changes)");
@@ -314,7 +314,8 @@ struct RunOptions {
       "also keep every checkpoint as checkpoints/ckpt_<samples>.pt in the "
       "run folder (for learning curves)");
     v("env_threads", self.env_threads, Range::Closed(1, 1024),
-      "OpenMP threads stepping environments");
+      "OpenMP threads stepping environments (capped at the CPUs this "
+      "process may use)");
     v("init_from", self.init_from, Range::Any(),
       "a fresh run starts from this checkpoint's networks and observation "
       "normalizer (same character, observation and network sizes); the "

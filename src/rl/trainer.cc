@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "common/cpus.h"
 #include "common/error.h"
 #include "common/file_io.h"
 #include "env/vec_env.h"
@@ -159,8 +160,13 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.checkpoint_path = run.run_dir + "/checkpoint.pt";
   // With overlap, collection (this thread) and update (a second one) each
   // run LibTorch on one thread.
-  const int start_threads =
-      config.ppo.overlap_update ? 1 : config.ppo.torch_threads;
+  const int cpus = UsableCpus();
+  const int start_threads = config.ppo.overlap_update
+                                ? 1
+                                : CapThreadsAtCpus(config.ppo.torch_threads,
+                                                   cpus, "agent.torch_threads");
+  const int env_threads =
+      CapThreadsAtCpus(run.env_threads, cpus, "run.env_threads");
   at::set_num_threads(start_threads);
   torch::manual_seed(run.seed);
   s.generator = at::make_generator<at::CPUGeneratorImpl>(run.seed);
@@ -193,12 +199,12 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
   s.SetUpNetworkSettings(start_threads, start_precision);
   s.envs = std::make_unique<VecEnv>(s.character, s.reference, s.initial_states,
                                     config.env, config.ppo.num_envs, run.seed,
-                                    run.env_threads);
+                                    env_threads);
   s.envs->SetReferenceNoise(config.env.training_reference_noise());
   if (config.asi.enabled) {
     s.asi = std::make_unique<AsiUpdater>(s.character, s.reference,
                                          s.initial_states, config.env,
-                                         config.asi, run.seed, run.env_threads);
+                                         config.asi, run.seed, env_threads);
   }
   if (config.asi.hard_view_share > 0.0) {
     // The records start empty (also on resume: they are not checkpointed);
@@ -333,7 +339,8 @@ void Trainer::State::SetUpNetworkSettings(int start_threads,
   // the start-up precision, and the other with auto where bf16 runs.
   // Ordered so that the first probe is a thread count (the common change).
   std::vector<int> thread_counts = {start_threads};
-  if (config.ppo.adapt_torch_threads) thread_counts.push_back(1);
+  if (config.ppo.adapt_torch_threads && start_threads > 1)
+    thread_counts.push_back(1);
   std::vector<TrainingPrecision> precisions = {start_precision};
   if (config.ppo.training_precision == TrainingPrecision::kAuto &&
       ProbeBf16().runs) {

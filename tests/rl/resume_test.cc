@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cli/cli_test_util.h"
+#include "common/cpus.h"
 #include "common/error.h"
 #include "common/file_io.h"
 #include "env/env_fixture.h"
@@ -693,6 +694,50 @@ TEST(Trainer, AutoTrainsInFp32WhereBf16DoesNotRun) {
   } else {
     EXPECT_EQ(explicit_bf16.exit_code, 0) << explicit_bf16.output;
   }
+  fs::remove_all(dir);
+}
+
+// More threads than CPUs only time-slice (torch_threads 500 trained at 57
+// samples/s on 2 CPUs): the trainer caps both thread counts at the CPUs
+// this process may use, and says so. In a child process under taskset, one
+// CPU: the log's torch_threads column reads 1 for a config asking 2.
+TEST(Trainer, ThreadCountsAreCappedAtTheUsableCpus) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("trainer_thread_cap");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.torch_threads = UsableCpus() + 3;
+  config.run.env_threads = UsableCpus() + 5;
+  config.ppo.adapt_torch_threads = false;
+  config.ppo.training_precision = TrainingPrecision::kFp32;
+  config.Validate();
+  RunResult run = TrainIterations(config, /*resume=*/false, 2);
+  ASSERT_EQ(run.progress.size(), 2u);
+  for (const TrainProgress& p : run.progress)
+    EXPECT_EQ(p.torch_threads, UsableCpus());
+
+  config.ppo.torch_threads = 2;
+  config.ppo.adapt_torch_threads = true;
+  config.run.env_threads = 2;
+  config.run.total_samples = 2 * kBatch;
+  config.run.run_dir = dir + "/run_taskset";
+  config.Validate();
+  WriteFileAtomic(dir + "/two.yaml", TrainConfigToYaml(config));
+  const testing::CommandResult one_cpu =
+      testing::RunCommand("taskset -c 0 " + std::string(MIMIC2D_BINARY) +
+                          " train " + dir + "/two.yaml");
+  ASSERT_EQ(one_cpu.exit_code, 0) << one_cpu.output;
+  EXPECT_NE(one_cpu.output.find("agent.torch_threads 2 exceeds the 1 CPU(s) "
+                                "this process may use; using 1"),
+            std::string::npos)
+      << one_cpu.output;
+  EXPECT_NE(one_cpu.output.find("run.env_threads 2 exceeds the 1 CPU(s)"),
+            std::string::npos)
+      << one_cpu.output;
+  const TrainingCurves curves =
+      ReadTrainingLog(config.run.run_dir + "/train_log.csv");
+  ASSERT_EQ(curves.num_rows(), 2);
+  for (double threads : curves.columns.at("torch_threads"))
+    EXPECT_EQ(threads, 1.0);
   fs::remove_all(dir);
 }
 

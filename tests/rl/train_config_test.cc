@@ -284,5 +284,28 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
                     "is a folder, not a file", false);
 }
 
+// Config paths are read from the working directory: a command started
+// outside the repository's root hears which directory that was.
+TEST(TrainConfig, AMissingRelativePathNamesTheWorkingDirectory) {
+  const auto message_of = [](const std::string& path) -> std::string {
+    try {
+      ReadFileText(path);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string relative = message_of("no_such_folder/config.yaml");
+  EXPECT_NE(relative.find("no_such_folder/config.yaml: cannot open file (No "
+                          "such file or directory); relative paths are read "
+                          "from the working directory " +
+                          std::filesystem::current_path().string()),
+            std::string::npos)
+      << relative;
+  const std::string absolute = message_of("/no_such_folder/config.yaml");
+  EXPECT_NE(absolute.find("cannot open file"), std::string::npos) << absolute;
+  EXPECT_EQ(absolute.find("working directory"), std::string::npos) << absolute;
+}
+
 }  // namespace
 }  // namespace m2d
