@@ -2,8 +2,7 @@
 
 #include <omp.h>
 
-#include <thread>
-
+#include "common/cpus.h"
 #include "common/error.h"
 
 namespace m2d {
@@ -14,10 +13,7 @@ VecEnv::VecEnv(std::shared_ptr<const Character> character,
                const TrackingEnvOptions& options, int num_envs, uint64_t seed,
                int num_threads) {
   if (num_envs < 1) throw ConfigError("vec env: num_envs must be >= 1");
-  num_threads_ =
-      num_threads > 0
-          ? num_threads
-          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  num_threads_ = num_threads > 0 ? num_threads : UsableCpus();
   for (int i = 0; i < num_envs; ++i) {
     envs_.push_back(std::make_unique<TrackingEnv>(
         character, reference, initial_states, options,

@@ -20,8 +20,9 @@ struct FinishedEpisode {
 
 class VecEnv {
  public:
-  // `num_threads` <= 0 uses every core. Environment i is seeded seed + i,
-  // so results do not depend on the thread count.
+  // `num_threads` <= 0 uses every CPU this process may run on (UsableCpus).
+  // Environment i is seeded seed + i, so results do not depend on the thread
+  // count.
   VecEnv(std::shared_ptr<const Character> character,
          std::shared_ptr<const TrackingReference> reference,
          std::shared_ptr<const InitialStates> initial_states,
