@@ -34,10 +34,6 @@ struct FitArgs {
   bool quiet = false;
 };
 
-// More than this share of a view's frames unconverged fails the command
-// (the estimate is still written, for inspection).
-constexpr double kMaxUnconvergedFraction = 0.25;
-
 int RunFit(FitArgs& args) {
   if (args.list_settings) {
     std::printf("%s", FitSettingsReference().c_str());
@@ -94,10 +90,9 @@ int RunFit(FitArgs& args) {
         std::printf("view %d/%zu (%s): %s\n", view + 1, bundle.views.size(),
                     bundle.views[view].name.c_str(),
                     summary.BriefReport().c_str());
-        if (summary.unconverged_frames.size() >
-            kMaxUnconvergedFraction * summary.num_frames) {
-          ++failed_views;
-        }
+        // An unreliable view fails the command; the estimate is still
+        // written, for inspection.
+        if (summary.Unreliable()) ++failed_views;
         if (truth) {  // the measurement's side, after the fit
           accuracies.push_back(
               MeasureFitAccuracy(estimate, truth->views[view].cameras,

@@ -1,5 +1,7 @@
 #include "env/task.h"
 
+#include <spdlog/spdlog.h>
+
 #include "common/error.h"
 
 namespace m2d {
@@ -9,6 +11,25 @@ TrackingTask BuildTrackingTask(std::shared_ptr<const Character> character,
                                const TrackingTaskOptions& options) {
   TrackingTask task;
   task.character = std::move(character);
+  // `mimic2d fit` fails on such a fit but writes it for inspection: say so
+  // when a task is built on it anyway.
+  if (options.sources.initial_states == InitialStateSource::kEstimate ||
+      options.sources.cameras == CameraSource::kEstimate) {
+    for (const ReferenceBundle& bundle : bundles) {
+      if (!bundle.estimate) continue;  // Prepare names the missing estimate
+      for (size_t v = 0; v < bundle.estimate->size(); ++v) {
+        const FitSummary& fit = (*bundle.estimate)[v].summary;
+        if (!fit.Unreliable()) continue;
+        spdlog::warn(
+            "{}: the fit of view {} did not converge on {} of {} frames "
+            "(more than {:.0f}%): starts and cameras from it are "
+            "unreliable; fit it again (docs/fit.md)",
+            bundle.name, v < bundle.views.size() ? bundle.views[v].name : "?",
+            fit.unconverged_frames.size(), fit.num_frames,
+            100 * kMaxUnconvergedFraction);
+      }
+    }
+  }
   task.reference = TrackingReference::Prepare(
       std::move(bundles), *task.character, options.simulation.control_hz,
       options.sources);

@@ -384,6 +384,11 @@ ReferenceBundle StripBundle(ReferenceBundle bundle) {
   return bundle;
 }
 
+bool FitSummary::Unreliable() const {
+  return static_cast<double>(unconverged_frames.size()) >
+         kMaxUnconvergedFraction * num_frames;
+}
+
 std::string FitSummary::BriefReport() const {
   // Outline: the model and start, the solve, the fit quality, the frames
   // that failed (first few).

@@ -42,6 +42,10 @@ struct GroundTruth3D {
 
 // What a fit (fit/fit.h) reports for one view: a brief account of the
 // solve, kept in the bundle beside the estimate it produced.
+// More than this share of a view's frames unconverged makes its fit
+// unreliable (FitSummary::Unreliable).
+inline constexpr double kMaxUnconvergedFraction = 0.25;
+
 struct FitSummary {
   std::string camera_model;    // "static" or "moving"
   bool focal_fixed = false;    // --focal given: focal length not estimated
@@ -56,6 +60,9 @@ struct FitSummary {
   double seconds = 0.0;                 // wall time of the fit
 
   bool converged() const { return unconverged_frames.empty(); }
+  // Too many frames whose residual stayed high to train on: `mimic2d fit`
+  // fails, and tasks built on the estimate warn (kMaxUnconvergedFraction).
+  bool Unreliable() const;
   // A few lines: iterations, cost, reprojection, frames that failed.
   std::string BriefReport() const;
 };

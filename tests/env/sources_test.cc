@@ -5,8 +5,12 @@
 #include "env/sources.h"
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <memory>
+#include <sstream>
 
 #include "common/error.h"
 #include "env/task.h"
@@ -251,6 +255,42 @@ TEST(Sources, NoisyStartsApplyOnTopOfTheEstimate) {
     }
   }
   EXPECT_EQ(changed, 2 * fixture.bundle.num_frames());
+}
+
+// `mimic2d fit` fails on a view whose frames mostly did not converge but
+// writes the estimate for inspection; a task built on it anyway warns,
+// naming the view, and one on the truth does not read the estimate at all.
+TEST(Sources, ATaskOnAnUnreliableFitWarns) {
+  Fixture fixture = MakeFixture();
+  FitSummary& fit = (*fixture.bundle.estimate)[1].summary;
+  fit.num_frames = fixture.bundle.num_frames();
+  EXPECT_FALSE(fit.Unreliable());
+  for (int t = 0; t <= fit.num_frames / 4; ++t)
+    fit.unconverged_frames.push_back(t);
+  EXPECT_TRUE(fit.Unreliable());
+  EXPECT_FALSE((*fixture.bundle.estimate)[0].summary.Unreliable());
+
+  auto log = std::make_shared<std::ostringstream>();
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(*log);
+  spdlog::default_logger()->sinks().push_back(sink);
+  Build(fixture, {InitialStateSource::kEstimate, CameraSource::kEstimate});
+  const std::string on_estimate = log->str();
+  log->str("");
+  Build(fixture, {InitialStateSource::kTruth, CameraSource::kTruth});
+  const std::string on_truth = log->str();
+  spdlog::default_logger()->sinks().pop_back();
+
+  EXPECT_NE(on_estimate.find("the fit of view " + fixture.bundle.views[1].name +
+                             " did not converge on " +
+                             std::to_string(fit.unconverged_frames.size()) +
+                             " of " + std::to_string(fit.num_frames) +
+                             " frames (more than 25%)"),
+            std::string::npos)
+      << on_estimate;
+  EXPECT_EQ(on_estimate.find("view " + fixture.bundle.views[0].name + " did"),
+            std::string::npos)
+      << on_estimate;
+  EXPECT_EQ(on_truth.find("did not converge"), std::string::npos) << on_truth;
 }
 
 }  // namespace
