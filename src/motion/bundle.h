@@ -40,12 +40,12 @@ struct GroundTruth3D {
   std::vector<Pose3D> poses;
 };
 
-// What a fit (fit/fit.h) reports for one view: a brief account of the
-// solve, kept in the bundle beside the estimate it produced.
 // More than this share of a view's frames unconverged makes its fit
 // unreliable (FitSummary::Unreliable).
 inline constexpr double kMaxUnconvergedFraction = 0.25;
 
+// What a fit (fit/fit.h) reports for one view: a brief account of the
+// solve, kept in the bundle beside the estimate it produced.
 struct FitSummary {
   std::string camera_model;    // "static" or "moving"
   bool focal_fixed = false;    // --focal given: focal length not estimated
