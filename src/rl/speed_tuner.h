@@ -14,6 +14,8 @@
 //
 // The tuner knows candidates by index; the caller maps them to settings
 // (rl/trainer.cc: threads x precision). Candidate 0 is the starting pick.
+// The caller leaves out iterations that span a stop of the process or the
+// machine's sleep (common/pauses.h): they measure the pause.
 #ifndef MIMIC2D_RL_SPEED_TUNER_H_
 #define MIMIC2D_RL_SPEED_TUNER_H_
 

@@ -15,6 +15,7 @@
 #include "common/cpus.h"
 #include "common/error.h"
 #include "common/file_io.h"
+#include "common/pauses.h"
 #include "env/vec_env.h"
 #include "motion/bundle.h"
 #include "rl/asi_updater.h"
@@ -460,6 +461,7 @@ TrainSummary Trainer::Run(
     }
     if (max_iterations > 0 && summary.iterations_run >= max_iterations) break;
     const Clock::time_point start = Clock::now();
+    const PauseMark pauses_at_start = MarkPauses();
     const double learning_rate = s.LearningRate();
     // 0. How the networks run (adaptive: the tuner's pick or probe).
     s.ChooseNetworkSetting();
@@ -479,7 +481,19 @@ TrainSummary Trainer::Run(
       s.SetLearningRate(
           AdaptLearningRate(learning_rate, step.losses.approx_kl, config.ppo));
     }
-    s.RecordNetworkSetting(step);
+    // A stop (Ctrl-Z, kill -STOP) or the machine's sleep within the
+    // iteration makes its samples/s the pause's: one such reading in the
+    // tuner's running average read as a slowdown and moved it off its
+    // pick (docs/training.md, "Throughput", item 3).
+    if (PausedBetween(pauses_at_start, MarkPauses())) {
+      ++summary.iterations_paused;
+      spdlog::info(
+          "iteration {}: the process was stopped or the machine slept; its "
+          "timing is left out of the choice of threads and precision",
+          s.counters.iteration + 1);
+    } else {
+      s.RecordNetworkSetting(step);
+    }
     // 3. Refresh the initial-state buffers (ASI).
     const Clock::time_point asi_start = Clock::now();
     ++s.counters.iteration;

@@ -741,5 +741,57 @@ TEST(Trainer, ThreadCountsAreCappedAtTheUsableCpus) {
   fs::remove_all(dir);
 }
 
+// `kill -STOP` / `-CONT` (or Ctrl-Z and fg) on a training: an iteration
+// that spans the stop measured the stop, and as one reading in the speed
+// tuner's running average it read as a slowdown and moved the tuner off
+// its pick (docs/training.md, "Throughput", item 3). Stopped 10 times for
+// 0.1 s mid-training, the command says which iterations it left out.
+TEST(Trainer, AStoppedIterationIsLeftOutOfTheSpeedTuner) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("trainer_stopped");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.torch_threads = 2;
+  config.ppo.adapt_torch_threads = true;
+  config.ppo.training_precision = TrainingPrecision::kFp32;
+  config.run.total_samples = 1'000'000'000;
+  config.Validate();
+  const std::string config_path = dir + "/tiny.yaml";
+  WriteFileAtomic(config_path, TrainConfigToYaml(config));
+  const std::string output_path = dir + "/out.txt";
+  const pid_t pid = StartTraining(config_path, "", output_path);
+  ASSERT_GT(pid, 0);
+  auto read_output = [&] {
+    std::ifstream in(output_path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  // Stop it only once it iterates (setup builds the task first).
+  for (int wait = 0;
+       wait < 600 && read_output().find("\nit ") == std::string::npos; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  for (int stop = 0; stop < 10; ++stop) {
+    ::kill(-pid, SIGSTOP);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ::kill(-pid, SIGCONT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ::kill(-pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string output = read_output();
+  ASSERT_NE(output.find("interrupted after"), std::string::npos) << output;
+  // Most stops land inside an iteration's timing, some between two.
+  int left_out = 0;
+  const std::string notice =
+      "the process was stopped or the machine slept; its timing is left out";
+  for (size_t at = output.find(notice); at != std::string::npos;
+       at = output.find(notice, at + 1)) {
+    ++left_out;
+  }
+  EXPECT_GE(left_out, 1) << output.substr(0, 4000);
+  EXPECT_LE(left_out, 10);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace m2d

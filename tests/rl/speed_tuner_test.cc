@@ -2,11 +2,16 @@
 #include "rl/speed_tuner.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include <functional>
 #include <vector>
 
 #include "common/error.h"
+#include "common/pauses.h"
 
 namespace m2d {
 namespace {
@@ -120,6 +125,36 @@ TEST(SpeedTuner, InvalidOptionsAndCandidatesAreRejected) {
   tuner.Record(0, 1.0);
   EXPECT_FALSE(tuner.Record(5, 0.1));
   EXPECT_EQ(tuner.chosen(), 0);
+}
+
+// What the trainer leaves out of the tuner (common/pauses.h): an
+// iteration's timing that spans a stop of the process. Here a real one: a
+// child stops this process for 0.2 s and continues it.
+TEST(Pauses, AStopAndContinueOfThisProcessIsNoticed) {
+  const PauseMark start = MarkPauses();
+  EXPECT_FALSE(PausedBetween(start, MarkPauses()));
+  const pid_t parent = getpid();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // only async-signal-safe calls in the forked child
+    const timespec stopped = {0, 200'000'000};
+    kill(parent, SIGSTOP);
+    nanosleep(&stopped, nullptr);
+    kill(parent, SIGCONT);
+    _exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);  // returns once continued
+  EXPECT_TRUE(PausedBetween(start, MarkPauses()));
+  const PauseMark after = MarkPauses();
+  EXPECT_FALSE(PausedBetween(after, MarkPauses()));
+}
+
+TEST(Pauses, TheMachinesSleepCountsPastATenthOfASecond) {
+  const PauseMark awake{3, 12.0};
+  EXPECT_FALSE(PausedBetween(awake, {3, 12.0 + 0.5 * kMinSleepS}));
+  EXPECT_TRUE(PausedBetween(awake, {3, 12.0 + 2 * kMinSleepS}));
+  EXPECT_TRUE(PausedBetween(awake, {4, 12.0}));
 }
 
 }  // namespace
