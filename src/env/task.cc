@@ -8,14 +8,16 @@ namespace m2d {
 
 TrackingTask BuildTrackingTask(std::shared_ptr<const Character> character,
                                std::vector<ReferenceBundle> bundles,
-                               const TrackingTaskOptions& options) {
+                               const TrackingTaskOptions& options,
+                               const std::vector<std::string>& bundle_sources) {
   TrackingTask task;
   task.character = std::move(character);
   // `mimic2d fit` fails on such a fit but writes it for inspection: say so
   // when a task is built on it anyway.
   if (options.sources.initial_states == InitialStateSource::kEstimate ||
       options.sources.cameras == CameraSource::kEstimate) {
-    for (const ReferenceBundle& bundle : bundles) {
+    for (size_t b = 0; b < bundles.size(); ++b) {
+      const ReferenceBundle& bundle = bundles[b];
       if (!bundle.estimate) continue;  // Prepare names the missing estimate
       for (size_t v = 0; v < bundle.estimate->size(); ++v) {
         const FitSummary& fit = (*bundle.estimate)[v].summary;
@@ -24,7 +26,8 @@ TrackingTask BuildTrackingTask(std::shared_ptr<const Character> character,
             "{}: the fit of view {} did not converge on {} of {} frames "
             "(more than {:.0f}%): starts and cameras from it are "
             "unreliable; fit it again (docs/fit.md)",
-            bundle.name, v < bundle.views.size() ? bundle.views[v].name : "?",
+            b < bundle_sources.size() ? bundle_sources[b] : bundle.name,
+            v < bundle.views.size() ? bundle.views[v].name : "?",
             fit.unconverged_frames.size(), fit.num_frames,
             100 * kMaxUnconvergedFraction);
       }
@@ -51,7 +54,8 @@ TrackingTask BuildTrackingTask(const std::string& character_config,
   std::vector<std::string> names;
   for (const ReferenceBundle& bundle : bundles) names.push_back(bundle.name);
   try {
-    return BuildTrackingTask(std::move(character), std::move(bundles), options);
+    return BuildTrackingTask(std::move(character), std::move(bundles), options,
+                             bundle_paths);
   } catch (const InputError& e) {
     // Name the file the user gave rather than the bundle's inner name.
     for (size_t b = 0; b < names.size(); ++b) {

@@ -34,10 +34,12 @@ struct TrackingTask {
 };
 
 // Prepares `bundles` for `character` under the options' sources and fills
-// the initial states.
-TrackingTask BuildTrackingTask(std::shared_ptr<const Character> character,
-                               std::vector<ReferenceBundle> bundles,
-                               const TrackingTaskOptions& options);
+// the initial states. Warnings name each bundle by `bundle_sources` (its
+// file; empty: the bundles' inner names).
+TrackingTask BuildTrackingTask(
+    std::shared_ptr<const Character> character,
+    std::vector<ReferenceBundle> bundles, const TrackingTaskOptions& options,
+    const std::vector<std::string>& bundle_sources = {});
 
 // The same for the character of `character_config` in `scene` (loaded for
 // the options' simulation) and the bundle files `bundle_paths`.

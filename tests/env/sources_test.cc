@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
@@ -278,7 +279,23 @@ TEST(Sources, ATaskOnAnUnreliableFitWarns) {
   log->str("");
   Build(fixture, {InitialStateSource::kTruth, CameraSource::kTruth});
   const std::string on_truth = log->str();
+  // Read from a file (train, eval), the warning names the file.
+  log->str("");
+  const std::string dir = testing::TempDir("unreliable_fit");
+  const std::string path = dir + "/gliding.json";
+  WriteBundle(path, fixture.bundle);
+  TrackingTaskOptions options;
+  options.simulation = fixture.simulation;
+  options.sources = {InitialStateSource::kEstimate, CameraSource::kEstimate};
+  BuildTrackingTask(testing::SourcePath("assets/characters/humanoid.yaml"),
+                    "flat", {path}, options);
+  const std::string from_file = log->str();
   spdlog::default_logger()->sinks().pop_back();
+  EXPECT_NE(from_file.find(path + ": the fit of view " +
+                           fixture.bundle.views[1].name + " did not converge"),
+            std::string::npos)
+      << from_file;
+  std::filesystem::remove_all(dir);
 
   EXPECT_NE(on_estimate.find("the fit of view " + fixture.bundle.views[1].name +
                              " did not converge on " +
