@@ -60,8 +60,6 @@ int RunTrain(const TrainArgs& args) {
   Trainer trainer(config, args.resume);
 
   auto report = [&](const TrainProgress& p) {
-    double eta_s =
-        (config.run.total_samples - p.samples) / std::max(1.0, p.samples_per_s);
     double iteration_s = p.collect_s + p.update_s + p.asi_s;
     std::printf(
         "it %5d | %10lld samples | %6.0f samples/s (collect %2.0f%% update "
@@ -73,7 +71,7 @@ int RunTrain(const TrainArgs& args) {
         100 * p.asi_s / iteration_s, p.torch_threads, p.bf16 ? " bf16" : "",
         p.mean_return, p.mean_episode_length, 100 * p.succ, p.e2d_px,
         p.approx_kl, 100 * p.clip_fraction, p.learning_rate,
-        FormatDuration(eta_s).c_str());
+        FormatDuration(p.eta_s).c_str());
     std::fflush(stdout);
   };
   TrainSummary summary =

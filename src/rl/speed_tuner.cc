@@ -6,6 +6,10 @@
 
 namespace m2d {
 
+double RunningAverage(double average, double value, double weight) {
+  return average == 0 ? value : (1 - weight) * average + weight * value;
+}
+
 void SpeedTunerOptions::Validate() const {
   if (num_candidates < 2)
     throw ConfigError("speed tuner: num_candidates must be >= 2");
@@ -46,10 +50,8 @@ bool SpeedTuner::Record(int candidate, double seconds_per_sample) {
       iterations_since_probe_ = probe_interval_ - 1;  // probe next
     }
     // A running average: single iterations vary by a few percent.
-    chosen_average_ = chosen_average_ == 0
-                          ? seconds_per_sample
-                          : (1 - options_.average_weight) * chosen_average_ +
-                                options_.average_weight * seconds_per_sample;
+    chosen_average_ = RunningAverage(chosen_average_, seconds_per_sample,
+                                     options_.average_weight);
     ++iterations_since_probe_;
     return false;
   }

@@ -21,6 +21,10 @@
 
 namespace m2d {
 
+// An exponential running average: `value` itself while `average` is 0 (no
+// measurement yet), else (1 - weight) * average + weight * value.
+double RunningAverage(double average, double value, double weight);
+
 struct SpeedTunerOptions {
   int num_candidates = 2;        // settings to choose among (>= 2)
   int first_probe_after = 4;     // iterations between probes, at first

@@ -28,6 +28,10 @@ struct TrainProgress {
   int torch_threads = 1;  // LibTorch threads this iteration ran with
   bool bf16 = false;      // and whether its networks ran in bfloat16 (the
                           // log's 0/1: every cell of the log is a number)
+  // Not in the log: the time left to total_samples at the recent rate (an
+  // average over about 20 iterations, without those the process spent
+  // stopped: one iteration's rate swings the estimate by 10-20 %).
+  double eta_s = 0.0;
 };
 
 // What a resumed run may need from the log's last kept row (-1: absent).

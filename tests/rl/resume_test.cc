@@ -185,6 +185,30 @@ TEST(Resume, WithoutACheckpointStartsFresh) {
   fs::remove_all(dir);
 }
 
+// The progress line's ETA: the samples left at a running average of the
+// iterations' seconds per sample (weight 0.05), not at one iteration's
+// rate, which swings it by 10-20 % from line to line.
+TEST(Trainer, TheEtaIsTheSamplesLeftAtTheRecentRate) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  const std::string dir = testing::TempDir("trainer_eta");
+  TrainConfig config = TinyConfig(walk_path, dir);
+  config.run.total_samples = 100 * kBatch;
+  config.Validate();
+  RunResult run = TrainIterations(config, /*resume=*/false, 6);
+  ASSERT_EQ(run.progress.size(), 6u);
+  double average_s = 0.0;
+  for (const TrainProgress& p : run.progress) {
+    const double seconds_per_sample = 1.0 / p.samples_per_s;
+    average_s = average_s == 0.0 ? seconds_per_sample
+                                 : 0.95 * average_s + 0.05 * seconds_per_sample;
+    const double left =
+        static_cast<double>(config.run.total_samples - p.samples);
+    EXPECT_NEAR(p.eta_s, left * average_s, 1e-9 * left * average_s)
+        << "iteration " << p.iteration;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Resume, KeptCheckpointsAreNamedByTheSamplesTheyHold) {
   M2D_REQUIRE_SHARED(walk_path, kWalk);
   const std::string dir = testing::TempDir("resume_kept");
