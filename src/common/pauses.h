@@ -11,8 +11,8 @@ namespace m2d {
 
 struct PauseMark {
   int64_t continues = 0;  // SIGCONTs this process has received
-  double asleep_s =
-      0.0;  // CLOCK_BOOTTIME - CLOCK_MONOTONIC: the machine's sleep (s)
+  // CLOCK_BOOTTIME - CLOCK_MONOTONIC (s): how long the machine has slept.
+  double asleep_s = 0.0;
 };
 
 // Where the counts stand now. The first call installs a SIGCONT handler

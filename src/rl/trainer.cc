@@ -492,7 +492,6 @@ TrainSummary Trainer::Run(
     // tuner's running average read as a slowdown and moved it off its
     // pick (docs/training.md, "Throughput", item 3).
     if (PausedBetween(pauses_at_start, MarkPauses())) {
-      ++summary.iterations_paused;
       spdlog::info(
           "iteration {}: the process was stopped or the machine slept; its "
           "timing is left out of the choice of threads and precision",

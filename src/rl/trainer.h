@@ -17,9 +17,6 @@ namespace m2d {
 struct TrainSummary {
   TrainProgress last;
   int iterations_run = 0;  // in this invocation
-  // Of those, iterations during which the process was stopped or the
-  // machine slept: their timing is left out of the speed tuner.
-  int iterations_paused = 0;
   bool interrupted = false;
   std::string checkpoint_path;
 };
