@@ -34,8 +34,8 @@ struct TrackingTask {
 };
 
 // Prepares `bundles` for `character` under the options' sources and fills
-// the initial states. Warnings name each bundle by `bundle_sources` (its
-// file; empty: the bundles' inner names).
+// the initial states. Warnings and input errors name each bundle by
+// `bundle_sources` (its file; empty: the bundles' inner names).
 TrackingTask BuildTrackingTask(
     std::shared_ptr<const Character> character,
     std::vector<ReferenceBundle> bundles, const TrackingTaskOptions& options,
