@@ -1,6 +1,7 @@
 // tests: motions and bundles made here, without the shared data — a pose
-// carried forward at walking speed with a swinging joint, and a synthetic
-// `mimic2d fit` estimate (the truth seen in another world frame).
+// carried forward at walking speed with a swinging joint, a quadruped's
+// trot, and a synthetic `mimic2d fit` estimate (the truth seen in another
+// world frame).
 #ifndef MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
 #define MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
 
@@ -12,6 +13,7 @@
 
 #include "motion/bundle.h"
 #include "motion/motion3d.h"
+#include "motion/skeleton.h"
 
 namespace m2d::testing {
 
@@ -44,6 +46,74 @@ inline Pose3D IdentityPose(const Skeleton& skeleton, double height_m = 0.9) {
   pose.local_rotations.assign(skeleton.num_joints(),
                               Eigen::Quaterniond::Identity());
   return pose;
+}
+
+// A trot of the dog skeleton (assets/skeletons/dog.yaml) along +x at
+// `speed_m_s`, 2 strides a second: diagonal legs swing together (hips and
+// shoulders +-0.35 rad about y), each elbow or knee bending further while
+// its leg swings forward, the spine and head bobbing a little. Each frame's
+// root is lifted or lowered until its lowest paw keypoint is 2 cm up (the
+// paw's sole on the floor). Made here so that the dog's tests run without
+// the dog3d clips, which stay in ../shared.
+inline Motion3D SyntheticTrot(std::shared_ptr<const Skeleton> skeleton,
+                              const KeypointMap& keypoint_map,
+                              double duration_s, double fps = 30.0,
+                              double speed_m_s = 1.0) {
+  Motion3D motion;
+  motion.fps = fps;
+  const int num_frames = static_cast<int>(std::round(duration_s * fps)) + 1;
+  auto about_y = [](double angle_rad) {
+    return Eigen::Quaterniond(
+        Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitY()));
+  };
+  // Legs: (swinging joint, bending joint, bend sign, phase).
+  struct Leg {
+    const char* hip;
+    const char* knee;
+    double bend_sign;
+    double phase_rad;
+  };
+  const Leg legs[] = {{"left_shoulder", "left_forearm", 1.0, 0.0},
+                      {"right_upper_leg", "right_leg", -1.0, 0.0},
+                      {"right_shoulder", "right_forearm", 1.0, M_PI},
+                      {"left_upper_leg", "left_leg", -1.0, M_PI}};
+  std::vector<int> paws;
+  for (const char* paw :
+       {"left_front_paw", "right_front_paw", "left_back_paw", "right_back_paw"})
+    paws.push_back(keypoint_map.layout->IndexOf(paw));
+  for (int t = 0; t < num_frames; ++t) {
+    const double time_s = t / fps;
+    const double stride_rad = 2 * M_PI * 2.0 * time_s;
+    Pose3D pose;
+    pose.root_position_m = {speed_m_s * time_s, 0.0, 0.0};
+    pose.local_rotations.assign(skeleton->num_joints(),
+                                Eigen::Quaterniond::Identity());
+    for (const Leg& leg : legs) {
+      const double swing = std::sin(stride_rad + leg.phase_rad);
+      // Positive y turns a hanging leg backward: forward swing is -y.
+      pose.local_rotations[skeleton->IndexOf(leg.hip)] = about_y(-0.35 * swing);
+      const double bend =
+          0.3 + 0.5 * std::max(0.0, std::cos(stride_rad + leg.phase_rad));
+      // A revolute joint turns about its skeleton axis (-y for both).
+      pose.local_rotations[skeleton->IndexOf(leg.knee)] =
+          Eigen::Quaterniond(Eigen::AngleAxisd(
+              leg.bend_sign * bend,
+              skeleton->joints[skeleton->IndexOf(leg.knee)].axis));
+    }
+    pose.local_rotations[skeleton->IndexOf("spine1")] =
+        about_y(0.05 * std::sin(2 * stride_rad));
+    // The head held up, snout forward (its rest snout points down).
+    pose.local_rotations[skeleton->IndexOf("head")] =
+        about_y(-1.2 + 0.1 * std::sin(2 * stride_rad));
+    const std::vector<Eigen::Vector3d> points =
+        KeypointPositions(*skeleton, keypoint_map, pose);
+    double lowest_m = 1e9;
+    for (int paw : paws) lowest_m = std::min(lowest_m, points[paw].z());
+    pose.root_position_m.z() += 0.02 - lowest_m;
+    motion.frames.push_back(pose);
+  }
+  motion.skeleton = std::move(skeleton);
+  return motion;
 }
 
 // The world moved by p' = R(yaw) p + shift (a rotation about z and a

@@ -353,11 +353,17 @@ std::vector<Limb> FindLimbs(const KinematicModel& model) {
       }
       if (moved) limb.keypoints.push_back(k);
     }
-    // Each moving joint's hinges and the values its starts take.
+    // Each moving joint's hinges and the values its starts take. The grid
+    // spans the two moving joints nearest the trunk (shoulder and elbow, hip
+    // and knee); deeper ones (a quadruped's wrist and paw) start at rest, or
+    // the grid would grow as the product of every joint's (1 458 starts a
+    // frame for the dog's foreleg, against 18 for the two).
     std::vector<std::vector<double>> axis_values;
+    int gridded_joints = 0;
     for (int j = root; j < num_joints; ++j) {
       const auto& joint = model.joints[j];
       if (!moves[j] || joint.first_hinge < 0 || !in_subtree(j, root)) continue;
+      const bool gridded = gridded_joints++ < kLimbGridJoints;
       const int size = joint.num_hinges();
       for (int i = 0; i < size; ++i) {
         const int h = joint.first_hinge + i;
@@ -365,9 +371,9 @@ std::vector<Limb> FindLimbs(const KinematicModel& model) {
                      high = model.hinge_high_rad[h];
         const double rest = std::clamp(0.0, low, high);
         std::vector<double> values{rest};
-        if (size == 1) {
+        if (gridded && size == 1) {
           values.push_back(0.6 * (std::abs(low) > std::abs(high) ? low : high));
-        } else if (i < 2) {
+        } else if (gridded && i < 2) {
           values.push_back(0.6 * low);
           values.push_back(0.6 * high);
         }

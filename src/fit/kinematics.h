@@ -275,10 +275,12 @@ struct Limb {
 
 // The limbs of `model`: subtrees that are plain chains (no joint in them
 // has two children) under a joint that branches, with at least one
-// keypoint moved by their hinges. Starts: a grid over each moving joint's
-// range (a ball joint's first two axes, twist at rest; a hinge at rest and
-// toward its wider side), so that a limb raised forward, backward or out is
-// near one of them.
+// keypoint moved by their hinges. Starts: a grid over the ranges of the
+// limb's first kLimbGridJoints moving joints (a ball joint's first two
+// axes, twist at rest; a hinge at rest and toward its wider side), so that
+// a limb raised forward, backward or out is near one of them; joints
+// further out start at rest.
+constexpr int kLimbGridJoints = 2;
 std::vector<Limb> FindLimbs(const KinematicModel& model);
 
 // A fitted frame as the skeleton's Pose3D (the mapping the simulation uses,

@@ -40,6 +40,38 @@ const KeypointLayout& Coco17Layout() {
   return layout;
 }
 
+// AP-10K's 17 animal keypoints (MMPose's ap10k order; ViTPose+ and MMPose
+// animal models write it). The subject's root is the mean of the hips, as
+// COCO-17's.
+const KeypointLayout& Ap10kLayout() {
+  static const KeypointLayout layout = {
+      "ap10k",
+      {"left_eye", "right_eye", "nose", "neck", "root_of_tail", "left_shoulder",
+       "left_elbow", "left_front_paw", "right_shoulder", "right_elbow",
+       "right_front_paw", "left_hip", "left_knee", "left_back_paw", "right_hip",
+       "right_knee", "right_back_paw"},
+      // MMPose's ap10k drawing skeleton (0-based).
+      {{0, 1},
+       {0, 2},
+       {1, 2},
+       {2, 3},
+       {3, 4},
+       {3, 5},
+       {5, 6},
+       {6, 7},
+       {3, 8},
+       {8, 9},
+       {9, 10},
+       {4, 11},
+       {11, 12},
+       {12, 13},
+       {4, 14},
+       {14, 15},
+       {15, 16}},
+      {11, 14}};
+  return layout;
+}
+
 const KeypointLayout& PointLayout() {
   static const KeypointLayout layout = {"point", {"center"}, {}, {0}};
   return layout;
@@ -47,10 +79,11 @@ const KeypointLayout& PointLayout() {
 
 const KeypointLayout* FindLayout(const std::string& name) {
   if (name == "coco17") return &Coco17Layout();
+  if (name == "ap10k") return &Ap10kLayout();
   if (name == "point") return &PointLayout();
   return nullptr;
 }
 
-std::vector<std::string> LayoutNames() { return {"coco17", "point"}; }
+std::vector<std::string> LayoutNames() { return {"coco17", "ap10k", "point"}; }
 
 }  // namespace m2d

@@ -45,10 +45,13 @@ enum class Coco17 : int {
 };
 
 const KeypointLayout& Coco17Layout();
+// AP-10K's 17 animal keypoints (left_eye, ..., right_back_paw).
+const KeypointLayout& Ap10kLayout();
 // A single point (e.g. a ball's centre), for object tracks.
 const KeypointLayout& PointLayout();
 
-// The layout registered under `name` ("coco17", "point"); nullptr if none.
+// The layout registered under `name` ("coco17", "ap10k", "point"); nullptr
+// if none.
 const KeypointLayout* FindLayout(const std::string& name);
 // Names of all registered layouts, for error messages.
 std::vector<std::string> LayoutNames();

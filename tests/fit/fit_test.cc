@@ -21,6 +21,7 @@
 #include "motion/bundle.h"
 #include "motion/motion_io.h"
 #include "sim/simulation.h"
+#include "synthetic_motion.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -51,67 +52,79 @@ RandomPose MakeRandomPose(const KinematicModel& model, std::mt19937_64& rng) {
   return pose;
 }
 
+// For the humanoid (2 feet) and the dog (4 paws).
 TEST(FitKinematics, MatchesMujocoKeypointsAndSoles) {
-  auto character = Humanoid();
-  const KinematicModel model = KinematicModel::FromCharacter(*character);
-  ASSERT_EQ(model.num_keypoints(), 17);
-  ASSERT_EQ(model.num_feet, 2);
-  ASSERT_EQ(model.num_sole_points(), 8);
-  Simulation simulation(character, SimulationOptions());
-  std::mt19937_64 rng(7);
-  double worst_m = 0.0;
-  for (int trial = 0; trial < 20; ++trial) {
-    const RandomPose pose = MakeRandomPose(model, rng);
-    simulation.Reset();
-    simulation.SetPose(FittedPose(*character, pose.root_m.data(),
-                                  pose.quaternion_wxyz.data(),
-                                  pose.hinges_rad.data()));
-    std::vector<double> points(3 * (17 + 8));
-    CharacterPoints(model, pose.root_m.data(), pose.quaternion_wxyz.data(),
-                    pose.hinges_rad.data(), points.data());
-    const mjData* data = simulation.data();
-    const mjModel* mj = character->model();
-    // Keypoints: MuJoCo's sites.
-    for (int j = 0; j < 17; ++j) {
-      const int site = character->keypoint_sites()[j];
-      for (int k = 0; k < 3; ++k) {
-        worst_m = std::max(worst_m, std::abs(points[3 * j + k] -
-                                             data->site_xpos[3 * site + k]));
-      }
-    }
-    // Soles: the lowest point of each foot box in MuJoCo is one of ours.
-    for (int foot = 0; foot < 2; ++foot) {
-      const int body = character->ground_contact_bodies()[foot];
-      for (int g = 0; g < mj->ngeom; ++g) {
-        if (mj->geom_bodyid[g] != body) continue;
-        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>
-            rotation(data->geom_xmat + 9 * g);
-        const Eigen::Vector3d centre(data->geom_xpos + 3 * g);
-        const Eigen::Vector3d size(mj->geom_size + 3 * g);
-        double lowest = 1e9;
-        for (int sx : {-1, 1})
-          for (int sy : {-1, 1})
-            for (int sz : {-1, 1}) {
-              lowest = std::min(
-                  lowest, (centre + rotation * Eigen::Vector3d(sx * size.x(),
-                                                               sy * size.y(),
-                                                               sz * size.z()))
-                              .z());
-            }
-        double ours = 1e9;
-        for (int s = 0; s < 8; ++s) {
-          if (model.sole_foot[s] == foot)
-            ours = std::min(ours, points[3 * (17 + s) + 2]);
+  struct Case {
+    std::shared_ptr<const Character> character;
+    int num_feet;
+    double standing_root_height_m;
+  };
+  for (const Case& c :
+       {Case{Humanoid(), 2, 0.881416}, Case{testing::Dog(), 4, 0.695825}}) {
+    const std::shared_ptr<const Character>& character = c.character;
+    SCOPED_TRACE(character->name());
+    const KinematicModel model = KinematicModel::FromCharacter(*character);
+    ASSERT_EQ(model.num_keypoints(), 17);
+    ASSERT_EQ(model.num_feet, c.num_feet);
+    ASSERT_EQ(model.num_sole_points(), 4 * c.num_feet);
+    const int num_soles = model.num_sole_points();
+    Simulation simulation(character, SimulationOptions());
+    std::mt19937_64 rng(7);
+    double worst_m = 0.0;
+    for (int trial = 0; trial < 20; ++trial) {
+      const RandomPose pose = MakeRandomPose(model, rng);
+      simulation.Reset();
+      simulation.SetPose(FittedPose(*character, pose.root_m.data(),
+                                    pose.quaternion_wxyz.data(),
+                                    pose.hinges_rad.data()));
+      std::vector<double> points(3 * (17 + num_soles));
+      CharacterPoints(model, pose.root_m.data(), pose.quaternion_wxyz.data(),
+                      pose.hinges_rad.data(), points.data());
+      const mjData* data = simulation.data();
+      const mjModel* mj = character->model();
+      // Keypoints: MuJoCo's sites.
+      for (int j = 0; j < 17; ++j) {
+        const int site = character->keypoint_sites()[j];
+        for (int k = 0; k < 3; ++k) {
+          worst_m = std::max(worst_m, std::abs(points[3 * j + k] -
+                                               data->site_xpos[3 * site + k]));
         }
-        // Our soles are the box's 4 lowest corners in the foot frame: the
-        // lowest world corner is among them unless the foot is upside down.
-        EXPECT_LE(ours, lowest + 0.2);
-        EXPECT_GE(ours, lowest - 1e-9);
+      }
+      // Soles: the lowest point of each foot box in MuJoCo is one of ours.
+      for (int foot = 0; foot < c.num_feet; ++foot) {
+        const int body = character->ground_contact_bodies()[foot];
+        for (int g = 0; g < mj->ngeom; ++g) {
+          if (mj->geom_bodyid[g] != body) continue;
+          const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>
+              rotation(data->geom_xmat + 9 * g);
+          const Eigen::Vector3d centre(data->geom_xpos + 3 * g);
+          const Eigen::Vector3d size(mj->geom_size + 3 * g);
+          double lowest = 1e9;
+          for (int sx : {-1, 1})
+            for (int sy : {-1, 1})
+              for (int sz : {-1, 1}) {
+                lowest = std::min(
+                    lowest, (centre + rotation * Eigen::Vector3d(sx * size.x(),
+                                                                 sy * size.y(),
+                                                                 sz * size.z()))
+                                .z());
+              }
+          double ours = 1e9;
+          for (int s = 0; s < num_soles; ++s) {
+            if (model.sole_foot[s] == foot)
+              ours = std::min(ours, points[3 * (17 + s) + 2]);
+          }
+          // Our soles are the box's 4 lowest corners in the foot frame: the
+          // lowest world corner is among them unless the foot is upside
+          // down.
+          EXPECT_LE(ours, lowest + 0.2);
+          EXPECT_GE(ours, lowest - 1e-9);
+        }
       }
     }
+    EXPECT_LT(worst_m, 1e-9);
+    EXPECT_NEAR(model.standing_root_height_m, c.standing_root_height_m, 1e-6);
   }
-  EXPECT_LT(worst_m, 1e-9);
-  EXPECT_NEAR(model.standing_root_height_m, 0.881416, 1e-6);
 }
 
 // The fit's centre of mass is MuJoCo's (the mass-weighted mean of the
@@ -425,6 +438,36 @@ TEST(FitKinematics, FindsTheLimbsAndTheirStarts) {
   EXPECT_EQ(found, expected);
 }
 
+// The dog's limbs: four legs and the head (the tail carries no AP-10K
+// keypoint that its own hinges move). The start grid spans each limb's two
+// moving joints nearest the trunk: a shoulder or hip (9 starts) times an
+// elbow or knee (2), and the neck times the head joint (9 x 9); the wrists,
+// ankles and paws start at rest.
+TEST(FitKinematics, FindsTheDogsLimbsWithAGridOverTheirFirstTwoJoints) {
+  auto character = testing::Dog();
+  const KinematicModel model = KinematicModel::FromCharacter(*character);
+  const KeypointLayout& layout = character->keypoint_layout();
+  ASSERT_EQ(layout.name, "ap10k");
+  std::set<std::set<std::string>> found;
+  for (const Limb& limb : FindLimbs(model)) {
+    std::set<std::string> names;
+    for (int k : limb.keypoints) names.insert(layout.keypoint_names[k]);
+    found.insert(names);
+    const bool head = names.count("nose") > 0;
+    EXPECT_EQ(limb.starts.size(), head ? 81u : 18u);
+    // A leg: shoulder or hip (3), elbow or knee (1), wrist or ankle (3),
+    // paw (3).
+    EXPECT_EQ(limb.hinges.size(), head ? 6u : 10u);
+  }
+  const std::set<std::set<std::string>> expected{
+      {"left_elbow", "left_front_paw"},
+      {"right_elbow", "right_front_paw"},
+      {"left_knee", "left_back_paw"},
+      {"right_knee", "right_back_paw"},
+      {"nose", "left_eye", "right_eye"}};
+  EXPECT_EQ(found, expected);
+}
+
 // The limb search composes only the joints a limb's hinges move, the rest
 // of the body held in doubles (MovedJointFrames in LimbCost): for every
 // limb, a changed limb pose must land each joint where the whole chain
@@ -532,6 +575,50 @@ TEST(Fit, RecoversAKnownStaticCameraAndThePoses) {
     // The humanoid ships its learned pose prior; auto takes it.
     EXPECT_EQ(estimate.summary.pose_prior.rfind("mixture of 8", 0), 0u)
         << estimate.summary.pose_prior;
+  }
+}
+
+// A quadruped through the same fit: the synthetic trot (no shared data)
+// seen as AP-10K keypoints by 2 static cameras, focal known. With no pose
+// prior for the dog the pose is pulled toward rest (docs/quadruped.md).
+TEST(Fit, RecoversTheCameraAndPosesOfASyntheticDogTrot) {
+  auto character = testing::Dog();
+  BundleFromMotionOptions bundle_options;
+  bundle_options.rig.num_views = 2;
+  bundle_options.rig.elevation_deg = 15.0;
+  bundle_options.rig.elevation_span_deg = 10.0;
+  bundle_options.rig.distance_m = 4.0;
+  bundle_options.rig.focal_px = 1400.0;
+  bundle_options.rig.target_m = {0.0, 0.0, 0.4};  // the dog's middle
+  bundle_options.aim = RigAim::kPathMiddle;
+  const ReferenceBundle bundle = MakeBundleFromMotion(
+      testing::SyntheticTrot(character->shared_skeleton(),
+                             character->keypoint_map(), 1.5),
+      character->keypoint_map(), bundle_options, "trot");
+  FitOptions options;
+  options.fixed_focal_px = 1400.0;
+  for (size_t v = 0; v < bundle.views.size(); ++v) {
+    const ViewEstimate estimate =
+        FitView(bundle.views[v].clip, *character, options, "trot");
+    const Eigen::Vector2d true_angles =
+        CameraPitchRollRad(bundle.views[v].cameras[0]);
+    const Eigen::Vector2d angles = CameraPitchRollRad(estimate.cameras[0]);
+    const double error_m = YawAlignedRootRelativeErrorM(
+        estimate.poses, *bundle.ground_truth, *character);
+    std::printf(
+        "%s\nview %zu: pitch %.2f (true %.2f) deg, roll %.2f (%.2f) deg, "
+        "root-relative %.0f mm\n",
+        estimate.summary.BriefReport().c_str(), v, angles[0] * 180 / M_PI,
+        true_angles[0] * 180 / M_PI, angles[1] * 180 / M_PI,
+        true_angles[1] * 180 / M_PI, error_m * 1000);
+    // Measured 2026-11-30: pitch 3.4 and 2.6 deg off, roll 4.6 and 1.3,
+    // 2.3 px, 74 and 63 mm. The bounds are wider than the humanoid's (5 deg,
+    // 80 mm): the dog has no learned pose prior yet.
+    EXPECT_EQ(estimate.summary.pose_prior, "rest");
+    EXPECT_NEAR(angles[0], true_angles[0], 7 * M_PI / 180);
+    EXPECT_NEAR(angles[1], true_angles[1], 7 * M_PI / 180);
+    EXPECT_LT(estimate.summary.mean_reprojection_px, 5.0);
+    EXPECT_LT(error_m, 0.1);
   }
 }
 

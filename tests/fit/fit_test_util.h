@@ -15,6 +15,12 @@ inline std::shared_ptr<const Character> Humanoid() {
   return character;
 }
 
+// The dog on the flat scene, loaded once per test binary.
+inline std::shared_ptr<const Character> Dog() {
+  static const std::shared_ptr<const Character> character = LoadDog("flat");
+  return character;
+}
+
 }  // namespace m2d::testing
 
 #endif  // MIMIC2D_TESTS_FIT_FIT_TEST_UTIL_H_

@@ -116,6 +116,23 @@ TEST(ClipIo, PointLayoutRoundTrips) {
   ExpectSameClip(ClipFromJson(JsonCursor(text, "mem")), clip);
 }
 
+// Animal keypoints (MMPose's AP-10K, the dog's layout): written and read
+// under their name, hips as the root like COCO-17's.
+TEST(ClipIo, Ap10kLayoutRoundTrips) {
+  Clip2D clip = SampleClip();
+  clip.layout = FindLayout("ap10k");
+  ASSERT_NE(clip.layout, nullptr);
+  EXPECT_EQ(clip.layout, &Ap10kLayout());
+  EXPECT_EQ(clip.layout->num_keypoints(), 17);
+  EXPECT_EQ(clip.layout->keypoint_names[4], "root_of_tail");
+  EXPECT_EQ(clip.layout->root_keypoints,
+            (std::vector<int>{clip.layout->IndexOf("left_hip"),
+                              clip.layout->IndexOf("right_hip")}));
+  json text = ClipToJson(clip);
+  EXPECT_EQ(text["layout"], "ap10k");
+  ExpectSameClip(ClipFromJson(JsonCursor(text, "mem")), clip);
+}
+
 TEST(ClipIo, MissingKeypointIsWrittenAsNullNullZero) {
   json text = ClipToJson(SampleClip());
   EXPECT_EQ(text["format"], "mimic2d.clip");

@@ -1,5 +1,5 @@
-// tests: loading characters — the humanoid's structure and bindings, and
-// bad config input reported as InputError naming the file.
+// tests: loading characters — the humanoid's and the dog's structure and
+// bindings, and bad config input reported as InputError naming the file.
 #include "sim/character.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +17,7 @@ namespace m2d {
 namespace {
 
 using testing::HumanoidConfigPath;
+using testing::LoadDog;
 using testing::LoadHumanoid;
 using testing::SourcePath;
 using testing::TempDir;
@@ -80,6 +81,58 @@ TEST(CharacterTest, HumanoidPhysicsFollowsTheSourceFacts) {
     EXPECT_EQ(m->actuator_forcerange[2 * hinge.actuator_id + 1], e.torque_limit)
         << e.joint;
     EXPECT_EQ(m->jnt_stiffness[hinge.joint_id], 0.0) << e.joint;
+  }
+}
+
+// The dog (scripts/deepmimic_dog_to_mjcf.py from DeepMimic's dog3d): 23
+// bodies, 18 ball joints and 4 elbows and knees, AP-10K keypoint sites.
+TEST(CharacterTest, DogHas23BodiesAnd58ActuatedDofPlusFreeRoot) {
+  auto character = LoadDog("flat");
+  const mjModel* m = character->model();
+  EXPECT_EQ(character->bodies().size(), 23u);
+  EXPECT_EQ(character->num_actions(), 18 * 3 + 4);
+  EXPECT_EQ(m->nq, 7 + 58);
+  EXPECT_EQ(m->nv, 6 + 58);
+  EXPECT_STREQ(mj_id2name(m, mjOBJ_BODY, character->root_body()), "root");
+  EXPECT_EQ(character->keypoint_layout().name, "ap10k");
+  EXPECT_EQ(character->keypoint_sites().size(), 17u);
+  EXPECT_EQ(character->ground_contact_bodies().size(), 4u);
+  for (const ActuatedHinge& hinge : character->hinges()) {
+    EXPECT_LT(hinge.range_low_rad, hinge.range_high_rad);
+    EXPECT_EQ(m->actuator_trnid[2 * hinge.actuator_id], hinge.joint_id);
+  }
+}
+
+// Masses and torque limits are DeepMimic's dog3d character file's, PD gains
+// its dog3d controller's.
+TEST(CharacterTest, DogPhysicsFollowsTheSourceFacts) {
+  auto character = LoadDog("flat");
+  const mjModel* m = character->model();
+  double total_kg = 0.0;
+  for (int body : character->bodies()) total_kg += m->body_mass[body];
+  EXPECT_NEAR(total_kg, 29.25, 1e-6);
+  EXPECT_NEAR(m->body_mass[character->BodyId("spine1")], 7.0, 1e-9);
+  EXPECT_NEAR(m->body_mass[character->BodyId("tail1")], 0.25, 1e-9);
+  const struct {
+    const char* joint;
+    double kp, kd, torque_limit;
+  } expected[] = {
+      {"spine0_y", 500, 50, 200},         {"head_x", 50, 5, 50},
+      {"left_shoulder_z", 200, 20, 150},  {"right_forearm", 200, 20, 100},
+      {"left_upper_leg_y", 300, 30, 200}, {"right_leg", 200, 20, 150},
+      {"left_toe_x", 80, 8, 50},          {"tail1_z", 10, 1, 25}};
+  for (const auto& e : expected) {
+    const int id = mj_name2id(m, mjOBJ_JOINT, e.joint);
+    const ActuatedHinge* hinge = nullptr;
+    for (const ActuatedHinge& h : character->hinges())
+      if (h.joint_id == id) hinge = &h;
+    ASSERT_NE(hinge, nullptr) << e.joint;
+    EXPECT_EQ(m->actuator_gainprm[hinge->actuator_id * mjNGAIN], e.kp)
+        << e.joint;
+    EXPECT_EQ(m->dof_damping[hinge->dof_address], e.kd) << e.joint;
+    EXPECT_EQ(m->actuator_forcerange[2 * hinge->actuator_id + 1],
+              e.torque_limit)
+        << e.joint;
   }
 }
 

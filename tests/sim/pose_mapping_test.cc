@@ -116,20 +116,24 @@ double MaxKeypointGap(const Character& character, mjData* data,
   return worst;
 }
 
+// For the humanoid and the dog: their MJCF sites are their skeletons'
+// keypoints, whatever the pose.
 TEST(PoseMappingTest, QposRoundTripAndSitesMatchSkeletonFkOnRandomPoses) {
-  auto character = LoadHumanoid("floating");
-  MujocoDataPtr data = MakeMujocoData(character->model());
-  std::mt19937 rng(11);
-  for (int i = 0; i < 200; ++i) {
-    const Pose3D pose = RandomPose(*character, &rng);
-    EXPECT_LT(MaxKeypointGap(*character, data.get(), pose), 1e-9);
-    const Pose3D back = QposToPose(*character, data->qpos);
-    EXPECT_LT((back.root_position_m - pose.root_position_m).norm(), 1e-12);
-    for (size_t j = 0; j < pose.local_rotations.size(); ++j) {
-      EXPECT_LT(
-          RotationDistance(back.local_rotations[j], pose.local_rotations[j]),
-          1e-9)
-          << character->skeleton().joints[j].name;
+  for (auto character : {LoadHumanoid("floating"), testing::LoadDog("flat")}) {
+    SCOPED_TRACE(character->name());
+    MujocoDataPtr data = MakeMujocoData(character->model());
+    std::mt19937 rng(11);
+    for (int i = 0; i < 200; ++i) {
+      const Pose3D pose = RandomPose(*character, &rng);
+      EXPECT_LT(MaxKeypointGap(*character, data.get(), pose), 1e-9);
+      const Pose3D back = QposToPose(*character, data->qpos);
+      EXPECT_LT((back.root_position_m - pose.root_position_m).norm(), 1e-12);
+      for (size_t j = 0; j < pose.local_rotations.size(); ++j) {
+        EXPECT_LT(
+            RotationDistance(back.local_rotations[j], pose.local_rotations[j]),
+            1e-9)
+            << character->skeleton().joints[j].name;
+      }
     }
   }
 }

@@ -1,4 +1,5 @@
-// tests: helpers shared by the sim tests (humanoid asset paths, actions).
+// tests: helpers shared by the sim tests (humanoid and dog asset paths,
+// actions).
 #ifndef MIMIC2D_TESTS_SIM_SIM_TEST_UTIL_H_
 #define MIMIC2D_TESTS_SIM_SIM_TEST_UTIL_H_
 
@@ -17,6 +18,16 @@ inline std::string HumanoidConfigPath() {
 inline std::shared_ptr<const Character> LoadHumanoid(
     const std::string& scene, const SimulationOptions& options = {}) {
   return LoadCharacterForSimulation(HumanoidConfigPath(), scene, options);
+}
+
+inline std::string DogConfigPath() {
+  return SourcePath("assets/characters/dog.yaml");
+}
+
+// The DeepMimic dog3d quadruped (assets/characters/dog.yaml).
+inline std::shared_ptr<const Character> LoadDog(
+    const std::string& scene, const SimulationOptions& options = {}) {
+  return LoadCharacterForSimulation(DogConfigPath(), scene, options);
 }
 
 // The normalized action whose PD target is `angle_rad` for every hinge.
