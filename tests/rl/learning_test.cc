@@ -13,6 +13,7 @@
 #include "motion/motion_io.h"
 #include "rl/torch_policy.h"
 #include "rl/trainer.h"
+#include "synthetic_motion.h"
 #include "test_paths.h"
 
 namespace m2d {
@@ -250,6 +251,59 @@ TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
       after.mean_frames);
   EXPECT_GT(after.mean_frames, before.mean_frames * kMin2dSurvivalGain);
   EXPECT_LT(after.e2d_px, before.e2d_px * kMax2dErrorRatio);
+}
+
+// The dog from 2D only (docs/quadruped.md): the synthetic trot (the dog3d
+// clips stay in ../shared) seen as AP-10K keypoints by 2 static views,
+// stripped, fitted with the dog character, trained and evaluated on the
+// fit's starts and cameras. Calibrated 2026-11-30 (seed 7, beside a
+// training): 200k samples gave frames 3.3 -> 3.8, too faint to test; 400k
+// (142 s) gives 3.3 -> 5.2 frames before the 100 px exit, E2D 24.6 -> 23.0
+// px over those longer rollouts, so only the survival is asserted (as for
+// the 3D tracker above).
+constexpr int64_t kDogTrainingSamples = 400'000;
+constexpr double kMinDogSurvivalGain = 1.3;  // measured 1.58x
+
+TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
+  std::string dir = testing::TempDir("learning_dog");
+  TrainConfig config;
+  config.data.character_config =
+      testing::SourcePath("assets/characters/dog.yaml");
+  auto character = LoadCharacterForSimulation(config.data.character_config,
+                                              "flat", config.env.simulation);
+  BundleFromMotionOptions bundle_options;
+  bundle_options.duration_s = 2.0;
+  bundle_options.rig.num_views = 2;
+  bundle_options.rig.elevation_deg = 10.0;
+  bundle_options.rig.distance_m = 4.0;
+  bundle_options.rig.focal_px = 1400.0;
+  bundle_options.rig.target_m = {0.0, 0.0, 0.4};
+  bundle_options.aim = RigAim::kPathMiddle;
+  ReferenceBundle stripped = StripBundle(MakeBundleFromMotion(
+      testing::SyntheticTrot(character->shared_skeleton(),
+                             character->keypoint_map(), 2.0),
+      character->keypoint_map(), bundle_options, "trot"));
+  FitOptions fit;
+  fit.fixed_focal_px = 1400.0;
+  fit.num_threads = 2;
+  ReferenceBundle fitted = FitBundle(stripped, *character, fit, "trot");
+  config.data.bundles = {dir + "/trot_fitted.json"};
+  WriteBundle(config.data.bundles[0], fitted);
+  config.data.initial_states = InitialStateSource::kEstimate;
+  config.data.cameras = CameraSource::kEstimate;
+  UseCiSizedLearning(dir, &config);
+  config.run.total_samples = kDogTrainingSamples;
+
+  Trainer trainer(config, /*resume=*/false);
+  TrainSummary summary = trainer.Run(0, nullptr, nullptr);
+  const auto [before, after] = EvaluateBeforeAndAfter(
+      config, summary.checkpoint_path, character, fitted, dir);
+  std::printf(
+      "dog from 2D only: untrained: Succ %.2f E2D %.1f px frames %.1f | "
+      "trained: Succ %.2f E2D %.1f px frames %.1f\n",
+      before.succ, before.e2d_px, before.mean_frames, after.succ, after.e2d_px,
+      after.mean_frames);
+  EXPECT_GT(after.mean_frames, before.mean_frames * kMinDogSurvivalGain);
 }
 
 }  // namespace
