@@ -30,10 +30,9 @@ make_one() {  # clip
   [ -f "$motion" ] || { echo "make_dog_dataset: $motion not found" >&2; return 1; }
   [ -f "$out/$clip.json" ] && return 0
   if [ ! -f "$out/${clip}_2d.json" ]; then
-    $bin clip from-motion "$motion" --skeleton assets/skeletons/dog.yaml \
-      --keypoint-map assets/skeletons/dog.ap10k.yaml --duration 2 --views 4 \
-      --elevation 5 --elevation-span 20 --distance 4.5 --focal 1400 \
-      --aim middle -o "$out/${clip}_truth.json" > /dev/null
+    $bin clip from-motion "$motion" --character "$character" --duration 2 \
+      --views 4 --elevation 5 --elevation-span 20 --distance 4.5 \
+      --focal 1400 --aim middle -o "$out/${clip}_truth.json" > /dev/null
     $bin clip strip "$out/${clip}_truth.json" -o "$out/${clip}_2d.json" \
       > /dev/null
   fi

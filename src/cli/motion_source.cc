@@ -8,15 +8,21 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "motion/motion_io.h"
+#include "sim/character.h"
 
 namespace m2d::cli {
 
 void AddMotionSourceOptions(CLI::App& command, MotionSourceArgs* args) {
   command.add_option("motion", args->path, "3D motion: DeepMimic .txt or .bvh")
       ->required();
+  command.add_option(
+      "--character", args->character,
+      "Character config whose skeleton and keypoint map a DeepMimic file is "
+      "read with (e.g. characters/dog.yaml; relative to assets/ unless "
+      "absolute); --skeleton and --keypoint-map override it");
   command.add_option("--skeleton", args->skeleton,
                      "Skeleton YAML for DeepMimic files (default: "
-                     "assets/skeletons/humanoid.yaml)");
+                     "the character's, else assets/skeletons/humanoid.yaml)");
   command.add_option(
       "--keypoint-map", args->keypoint_map,
       "Keypoint map YAML (default: humanoid or CMU BVH COCO-17 map)");
@@ -112,6 +118,11 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
     if (!(args.bvh_scale_m > 0)) {
       throw ConfigError("--bvh-scale must be positive");
     }
+    if (!args.character.empty() || !args.skeleton.empty()) {
+      throw ConfigError(
+          "--character and --skeleton apply to DeepMimic files: " + args.path +
+          " (BVH) carries its own skeleton");
+    }
     loaded.motion = ReadBvhMotion(args.path, args.bvh_scale_m, args.fps);
     std::string map_path = args.keypoint_map.empty()
                                ? AssetPath("skeletons/cmu_bvh.coco17.yaml")
@@ -119,14 +130,20 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
     loaded.keypoint_map = LoadKeypointMap(map_path, *loaded.motion.skeleton);
     return loaded;
   }
-  std::string skeleton_path = args.skeleton.empty()
-                                  ? AssetPath("skeletons/humanoid.yaml")
-                                  : args.skeleton;
+  // The skeleton and keypoint map: given, else the character's, else the
+  // humanoid's.
+  std::string skeleton_path = AssetPath("skeletons/humanoid.yaml");
+  std::string map_path = AssetPath("skeletons/humanoid.coco17.yaml");
+  if (!args.character.empty()) {
+    const CharacterConfig character =
+        LoadCharacterConfig(AssetArgumentPath(args.character));
+    skeleton_path = character.skeleton_path;
+    map_path = character.keypoint_map_path;
+  }
+  if (!args.skeleton.empty()) skeleton_path = args.skeleton;
+  if (!args.keypoint_map.empty()) map_path = args.keypoint_map;
   auto skeleton = std::make_shared<const Skeleton>(LoadSkeleton(skeleton_path));
   loaded.motion = ReadDeepMimicMotion(args.path, skeleton, args.fps);
-  std::string map_path = args.keypoint_map.empty()
-                             ? AssetPath("skeletons/humanoid.coco17.yaml")
-                             : args.keypoint_map;
   loaded.keypoint_map = LoadKeypointMap(map_path, *skeleton);
   return loaded;
 }

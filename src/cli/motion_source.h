@@ -13,6 +13,7 @@ namespace m2d::cli {
 
 struct MotionSourceArgs {
   std::string path;               // .txt (DeepMimic) or .bvh
+  std::string character;          // DeepMimic: config naming both below
   std::string skeleton;           // DeepMimic: skeleton YAML
   std::string keypoint_map;       // keypoint map YAML
   double bvh_scale_m = 0.056444;  // metres per BVH unit (CMU/cgspeed)

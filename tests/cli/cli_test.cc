@@ -193,6 +193,40 @@ void ExpectInputError(const std::string& arguments, const std::string& file,
       << result.output;
 }
 
+// `--character` reads a DeepMimic file with a character's skeleton and
+// keypoint map: two frames of the dog at rest, written here in DeepMimic's
+// format (the dog3d clips stay in ../shared), become AP-10K keypoints.
+TEST(Cli, ADogMotionBecomesABundleOfAnimalKeypoints) {
+  const std::string dir = testing::TempDir("cli_dog");
+  // Per frame: duration, root position and rotation, 18 ball joints'
+  // quaternions, 4 elbow and knee angles (Y up, as DeepMimic writes).
+  std::string frame = "[0.0333, 0, 0.6, 0, 1, 0, 0, 0";
+  for (int j = 0; j < 18; ++j) frame += ", 1, 0, 0, 0";
+  frame += ", 0.5, 0.5, -0.5, -0.5]";
+  const std::string motion = WriteFile(
+      dir, "dog.txt",
+      R"({"Loop": "none", "Frames": [)" + frame + ", " + frame + "]}");
+  CommandResult result = RunMimic2d("clip from-motion " + motion +
+                                    " --character characters/dog.yaml --views 2"
+                                    " -o " +
+                                    dir + "/dog.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const ReferenceBundle bundle = ReadBundle(dir + "/dog.json");
+  EXPECT_EQ(bundle.views[0].clip.layout->name, "ap10k");
+  EXPECT_EQ(bundle.ground_truth->skeleton_name, "dog");
+  // The humanoid's skeleton cannot read it, and says why.
+  ExpectInputError("clip from-motion " + motion + " -o " + dir + "/h.json",
+                   motion, "needs 44");
+  // A BVH file carries its own skeleton.
+  result = RunMimic2d(
+      "clip from-motion /usr/share/assimp/models/BVH/01_01.bvh --character "
+      "characters/dog.yaml -o " +
+      dir + "/b.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("carries its own skeleton"), std::string::npos)
+      << result.output;
+}
+
 // `clip strip` leaves what a user with videos has: the 2D, no truth, no
 // cameras, no estimate; `clip info` says so.
 TEST(Cli, ClipStripKeepsOnlyThe2D) {
