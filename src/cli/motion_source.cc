@@ -118,10 +118,9 @@ LoadedMotion LoadMotionSource(const MotionSourceArgs& args) {
     if (!(args.bvh_scale_m > 0)) {
       throw ConfigError("--bvh-scale must be positive");
     }
-    if (!args.character.empty() || !args.skeleton.empty()) {
-      throw ConfigError(
-          "--character and --skeleton apply to DeepMimic files: " + args.path +
-          " (BVH) carries its own skeleton");
+    if (!args.character.empty()) {
+      throw ConfigError("--character applies to DeepMimic files: " + args.path +
+                        " (BVH) carries its own skeleton");
     }
     loaded.motion = ReadBvhMotion(args.path, args.bvh_scale_m, args.fps);
     std::string map_path = args.keypoint_map.empty()

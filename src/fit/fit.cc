@@ -414,13 +414,13 @@ bool BackProjectToPlane(const Observations& obs, const Parameters& params,
 // every reprojection unchanged; it hands stage 3 the subject's travel,
 // which a local solver does not find from a subject walking in place.
 //
-// Each foot's ankle keypoint (-1: none): the one nearer its sole points.
+// Each foot's ankle keypoint (-1: none): of the layout's foot keypoints (a
+// person's ankles), the one nearest its sole points.
 std::vector<int> FootAnkles(const KinematicModel& model,
                             const KeypointLayout& layout,
                             const std::vector<std::vector<double>>& points) {
   const int num_keypoints = model.num_keypoints();
-  const int ankles[2] = {layout.IndexOf("left_ankle"),
-                         layout.IndexOf("right_ankle")};
+  const std::vector<int>& ankles = layout.foot_keypoints;
   std::vector<int> foot_ankle(model.num_feet, -1);
   for (int f = 0; f < model.num_feet; ++f) {
     Eigen::Vector3d sole = Eigen::Vector3d::Zero();

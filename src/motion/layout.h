@@ -17,6 +17,9 @@ struct KeypointLayout {
   std::vector<std::string> keypoint_names;
   std::vector<std::pair<int, int>> bones;  // pairs of keypoint indices
   std::vector<int> root_keypoints;         // root = mean of these
+  // The points the fit reads a foot's stance from in the 2D (a person's
+  // ankles), each matched to the foot whose soles it is nearest.
+  std::vector<int> foot_keypoints;
 
   int num_keypoints() const { return static_cast<int>(keypoint_names.size()); }
   // Index of `keypoint_name`, or -1.
