@@ -202,6 +202,33 @@ TEST(Learning, PerThreadCollectionLearnsTheWalk) {
       CollectionMode::kPerThread);
 }
 
+// Trains `config` CI-sized for `samples` from 2D only on `fitted` (written
+// as `stem`.json; every episode starts from the fit's poses and projects
+// with its cameras) and evaluates the untrained and the trained policy the
+// same way, printing both after `label`.
+BeforeAndAfter TrainAndEvaluateFrom2d(
+    const std::string& label, const std::string& stem,
+    const ReferenceBundle& fitted, std::shared_ptr<const Character> character,
+    const std::string& dir, TrainConfig config, int64_t samples) {
+  config.data.bundles = {dir + "/" + stem + ".json"};
+  WriteBundle(config.data.bundles[0], fitted);
+  config.data.initial_states = InitialStateSource::kEstimate;
+  config.data.cameras = CameraSource::kEstimate;
+  UseCiSizedLearning(dir, &config);
+  config.run.total_samples = samples;
+  Trainer trainer(config, /*resume=*/false);
+  TrainSummary summary = trainer.Run(0, nullptr, nullptr);
+  const BeforeAndAfter result = EvaluateBeforeAndAfter(
+      config, summary.checkpoint_path, character, fitted, dir);
+  std::printf(
+      "%s: untrained: Succ %.2f E2D %.1f px frames %.1f | trained: Succ %.2f "
+      "E2D %.1f px frames %.1f\n",
+      label.c_str(), result.before.succ, result.before.e2d_px,
+      result.before.mean_frames, result.after.succ, result.after.e2d_px,
+      result.after.mean_frames);
+  return result;
+}
+
 // Calibrated on this machine (issue 11): the same run from 2D only — the
 // bundle stripped of its 3D truth and cameras, then fitted; training and
 // evaluation start from the fitted poses and project with the fitted
@@ -231,24 +258,9 @@ TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
   fit.camera_motion = CameraMotion::kMoving;
   fit.num_threads = 2;
   ReferenceBundle fitted = FitBundle(stripped, *character, fit, "walk2s");
-  config.data.bundles = {dir + "/walk2s_fitted.json"};
-  WriteBundle(config.data.bundles[0], fitted);
-  config.data.initial_states = InitialStateSource::kEstimate;
-  config.data.cameras = CameraSource::kEstimate;
-
-  UseCiSizedLearning(dir, &config);
-
-  Trainer trainer(config, /*resume=*/false);
-  TrainSummary summary = trainer.Run(0, nullptr, nullptr);
-
-  // Evaluated as trained: fitted starts and cameras.
-  const auto [before, after] = EvaluateBeforeAndAfter(
-      config, summary.checkpoint_path, character, fitted, dir);
-  std::printf(
-      "from 2D only: untrained: Succ %.2f E2D %.1f px frames %.1f | trained: "
-      "Succ %.2f E2D %.1f px frames %.1f\n",
-      before.succ, before.e2d_px, before.mean_frames, after.succ, after.e2d_px,
-      after.mean_frames);
+  const auto [before, after] =
+      TrainAndEvaluateFrom2d("from 2D only", "walk2s_fitted", fitted, character,
+                             dir, config, kTrainingSamples);
   EXPECT_GT(after.mean_frames, before.mean_frames * kMin2dSurvivalGain);
   EXPECT_LT(after.e2d_px, before.e2d_px * kMax2dErrorRatio);
 }
@@ -287,22 +299,9 @@ TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
   fit.fixed_focal_px = 1400.0;
   fit.num_threads = 2;
   ReferenceBundle fitted = FitBundle(stripped, *character, fit, "trot");
-  config.data.bundles = {dir + "/trot_fitted.json"};
-  WriteBundle(config.data.bundles[0], fitted);
-  config.data.initial_states = InitialStateSource::kEstimate;
-  config.data.cameras = CameraSource::kEstimate;
-  UseCiSizedLearning(dir, &config);
-  config.run.total_samples = kDogTrainingSamples;
-
-  Trainer trainer(config, /*resume=*/false);
-  TrainSummary summary = trainer.Run(0, nullptr, nullptr);
-  const auto [before, after] = EvaluateBeforeAndAfter(
-      config, summary.checkpoint_path, character, fitted, dir);
-  std::printf(
-      "dog from 2D only: untrained: Succ %.2f E2D %.1f px frames %.1f | "
-      "trained: Succ %.2f E2D %.1f px frames %.1f\n",
-      before.succ, before.e2d_px, before.mean_frames, after.succ, after.e2d_px,
-      after.mean_frames);
+  const auto [before, after] =
+      TrainAndEvaluateFrom2d("dog from 2D only", "trot_fitted", fitted,
+                             character, dir, config, kDogTrainingSamples);
   EXPECT_GT(after.mean_frames, before.mean_frames * kMinDogSurvivalGain);
 }
 
