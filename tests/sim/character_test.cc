@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <regex>
 
 #include "common/error.h"
@@ -43,6 +44,33 @@ TEST(CharacterTest, HumanoidHas15BodiesAnd28ActuatedDofPlusFreeRoot) {
   }
 }
 
+// A hinge's PD servo as its source gives it.
+struct ServoFacts {
+  const char* joint;
+  double kp, kd, torque_limit;
+};
+
+// Each joint's servo has the expected kp (actuator gain), kd (joint
+// damping) and torque limit, and the joint no passive spring.
+void ExpectServos(const Character& character,
+                  std::initializer_list<ServoFacts> expected) {
+  const mjModel* m = character.model();
+  for (const ServoFacts& e : expected) {
+    const int id = mj_name2id(m, mjOBJ_JOINT, e.joint);
+    const ActuatedHinge* hinge = nullptr;
+    for (const ActuatedHinge& h : character.hinges())
+      if (h.joint_id == id) hinge = &h;
+    ASSERT_NE(hinge, nullptr) << e.joint;
+    EXPECT_EQ(m->actuator_gainprm[hinge->actuator_id * mjNGAIN], e.kp)
+        << e.joint;
+    EXPECT_EQ(m->dof_damping[hinge->dof_address], e.kd) << e.joint;
+    EXPECT_EQ(m->actuator_forcerange[2 * hinge->actuator_id + 1],
+              e.torque_limit)
+        << e.joint;
+    EXPECT_EQ(m->jnt_stiffness[hinge->joint_id], 0.0) << e.joint;
+  }
+}
+
 TEST(CharacterTest, HumanoidPhysicsFollowsTheSourceFacts) {
   auto character = LoadHumanoid("flat");
   const mjModel* m = character->model();
@@ -57,31 +85,13 @@ TEST(CharacterTest, HumanoidPhysicsFollowsTheSourceFacts) {
   EXPECT_NEAR(body_mass("left_lower_arm"), 1.0, 0.01);
   EXPECT_NEAR(body_mass("left_hand"), 0.5, 0.01);
   // PD gains (MimicKit) and no passive springs.
-  auto servo = [&](const char* joint) {
-    const int id = mj_name2id(m, mjOBJ_JOINT, joint);
-    for (const ActuatedHinge& hinge : character->hinges()) {
-      if (hinge.joint_id == id) return hinge;
-    }
-    ADD_FAILURE() << joint;
-    return ActuatedHinge();
-  };
-  const struct {
-    const char* joint;
-    double kp, kd, torque_limit;
-  } expected[] = {
-      {"abdomen_y", 1000, 100, 200},     {"neck_x", 100, 10, 50},
-      {"left_shoulder_z", 400, 40, 100}, {"right_elbow", 300, 30, 60},
-      {"left_hip_y", 500, 50, 200},      {"right_knee", 500, 50, 150},
-      {"left_ankle_x", 400, 40, 90}};
-  for (const auto& e : expected) {
-    const ActuatedHinge hinge = servo(e.joint);
-    EXPECT_EQ(m->actuator_gainprm[hinge.actuator_id * mjNGAIN], e.kp)
-        << e.joint;
-    EXPECT_EQ(m->dof_damping[hinge.dof_address], e.kd) << e.joint;
-    EXPECT_EQ(m->actuator_forcerange[2 * hinge.actuator_id + 1], e.torque_limit)
-        << e.joint;
-    EXPECT_EQ(m->jnt_stiffness[hinge.joint_id], 0.0) << e.joint;
-  }
+  ExpectServos(*character, {{"abdomen_y", 1000, 100, 200},
+                            {"neck_x", 100, 10, 50},
+                            {"left_shoulder_z", 400, 40, 100},
+                            {"right_elbow", 300, 30, 60},
+                            {"left_hip_y", 500, 50, 200},
+                            {"right_knee", 500, 50, 150},
+                            {"left_ankle_x", 400, 40, 90}});
 }
 
 // The dog (scripts/deepmimic_dog_to_mjcf.py from DeepMimic's dog3d): 23
@@ -113,27 +123,14 @@ TEST(CharacterTest, DogPhysicsFollowsTheSourceFacts) {
   EXPECT_NEAR(total_kg, 29.25, 1e-6);
   EXPECT_NEAR(m->body_mass[character->BodyId("spine1")], 7.0, 1e-9);
   EXPECT_NEAR(m->body_mass[character->BodyId("tail1")], 0.25, 1e-9);
-  const struct {
-    const char* joint;
-    double kp, kd, torque_limit;
-  } expected[] = {
-      {"spine0_y", 500, 50, 200},         {"head_x", 50, 5, 50},
-      {"left_shoulder_z", 200, 20, 150},  {"right_forearm", 200, 20, 100},
-      {"left_upper_leg_y", 300, 30, 200}, {"right_leg", 200, 20, 150},
-      {"left_toe_x", 80, 8, 50},          {"tail1_z", 10, 1, 25}};
-  for (const auto& e : expected) {
-    const int id = mj_name2id(m, mjOBJ_JOINT, e.joint);
-    const ActuatedHinge* hinge = nullptr;
-    for (const ActuatedHinge& h : character->hinges())
-      if (h.joint_id == id) hinge = &h;
-    ASSERT_NE(hinge, nullptr) << e.joint;
-    EXPECT_EQ(m->actuator_gainprm[hinge->actuator_id * mjNGAIN], e.kp)
-        << e.joint;
-    EXPECT_EQ(m->dof_damping[hinge->dof_address], e.kd) << e.joint;
-    EXPECT_EQ(m->actuator_forcerange[2 * hinge->actuator_id + 1],
-              e.torque_limit)
-        << e.joint;
-  }
+  ExpectServos(*character, {{"spine0_y", 500, 50, 200},
+                            {"head_x", 50, 5, 50},
+                            {"left_shoulder_z", 200, 20, 150},
+                            {"right_forearm", 200, 20, 100},
+                            {"left_upper_leg_y", 300, 30, 200},
+                            {"right_leg", 200, 20, 150},
+                            {"left_toe_x", 80, 8, 50},
+                            {"tail1_z", 10, 1, 25}});
 }
 
 TEST(CharacterTest, BallSceneAddsAFreeBallObject) {
