@@ -20,7 +20,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 data=${1:-runs/dataset}
 out=${2:-runs/dataset_table}
-bin=build/mimic2d
+# shellcheck source=bench/table_row.sh
+source bench/table_row.sh
 mkdir -p "$out"
 
 train_clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"
@@ -41,8 +42,7 @@ bundles() {
   for clip in $clips; do printf -- "--bundle %s/%s%s.json " "$data" "$clip" "$2"; done
 }
 
-# row NAME CHECKPOINT SPLIT NOISE SUFFIX [EVAL FLAGS...]: one table row.
-# The same clips' truth, for the from-2D rows' E3D only (eval --truth: the
+# truths SPLIT SUFFIX: the same clips' truth, for the from-2D rows' E3D only (eval --truth: the
 # policy and its task never read it).
 truths() {
   local clips=$train_clips
@@ -51,31 +51,20 @@ truths() {
   for clip in $clips; do printf -- "%s/%s%s_truth.json " "$data" "$clip" "$2"; done
 }
 
+# row NAME CHECKPOINT SPLIT NOISE SUFFIX [EVAL FLAGS...]: one table row.
 row() {
   local name=$1 checkpoint=$2 split=$3 noise=$4 suffix=$5
   shift 5
-  local tag
+  local tag noisy=""
   tag=$(echo "$name-$split-$noise" | tr ' ,*/' '____')
-  if [ ! -f "$checkpoint" ]; then
-    echo "| $name | $split | $noise | (no checkpoint $checkpoint) | | | | | |"
-    return
-  fi
-  local noisy=""
   [ "$noise" = noisy ] && noisy=_noisy
   # shellcheck disable=SC2046
-  $bin eval "$checkpoint" $(bundles "$split" "$noisy$suffix") \
-    --episodes 1 --episode-s 10 --success-measure "$measure" "$@" \
-    -o "$out/$tag.json" > "$out/$tag.txt"
-  # The "all" line: clip view eps frames Succ% E2D EO2D E3D E3Droot E3DPA Jitter.
-  # (mawk, Debian's awk, reserves `split`: the clips go in as `clips`.)
-  awk -v name="$name" -v clips="$split" -v noise="$noise" '
-    $1 == "all" { printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n",
-                  name, clips, noise, $5, $6, $8, $9, $10, $11 }' \
-    "$out/$tag.txt"
+  table_row "$name" "$split" "$noise" "$checkpoint" "$out/$tag" \
+    $(bundles "$split" "$noisy$suffix") --episodes 1 --episode-s 10 \
+    --success-measure "$measure" "$@"
 }
 
-echo "| method | clips | 2D | Succ % | E2D (px) | E3D (mm) | E3D root-rel. (mm) | PA-MPJPE (mm) | Jitter (10^3 m/s^3) |"
-echo "|---|---|---|---|---|---|---|---|---|"
+table_header
 for split in train unseen; do
   for noise in clean noisy; do
     row "3D-GT (truth starts, true cameras)" "$gt" "$split" "$noise" _truth
