@@ -6,6 +6,7 @@
 #define MIMIC2D_TESTS_SYNTHETIC_MOTION_H_
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -116,6 +117,21 @@ inline Motion3D SyntheticTrot(std::shared_ptr<const Skeleton> skeleton,
   return motion;
 }
 
+// A ball of `radius_m` resting at (x0, y0) until `kick_s`, then rolling
+// along +x at `speed_m_s` (no slowing), sampled at `fps` for `num_frames`.
+inline ObjectTrack3D RollingBallTrack(int num_frames, double fps,
+                                      double kick_s = 0.3,
+                                      double speed_m_s = 3.0,
+                                      double radius_m = 0.11, double x0_m = 0.5,
+                                      double y0_m = 0.2) {
+  ObjectTrack3D ball{"ball", {}};
+  for (int t = 0; t < num_frames; ++t) {
+    const double rolled_m = speed_m_s * std::max(0.0, t / fps - kick_s);
+    ball.positions_m.emplace_back(x0_m + rolled_m, y0_m, radius_m);
+  }
+  return ball;
+}
+
 // The world moved by p' = R(yaw) p + shift (a rotation about z and a
 // horizontal shift): the same physical scene in another world frame.
 struct WorldChange {
@@ -144,9 +160,9 @@ struct WorldChange {
   }
 };
 
-// An estimate of every view made from `bundle`'s truth and true cameras:
-// view k seen in the world moved by `changes[k]` (so each view has its own
-// frame, as `mimic2d fit` gives).
+// An estimate of every view made from `bundle`'s truth and true cameras
+// (and objects): view k seen in the world moved by `changes[k]` (so each
+// view has its own frame, as `mimic2d fit` gives).
 inline std::vector<ViewEstimate> EstimateFromTruth(
     const ReferenceBundle& bundle, const std::vector<WorldChange>& changes) {
   std::vector<ViewEstimate> estimate;
@@ -158,6 +174,12 @@ inline std::vector<ViewEstimate> EstimateFromTruth(
     view.skeleton_name = bundle.ground_truth->skeleton_name;
     for (const Pose3D& pose : bundle.ground_truth->poses)
       view.poses.push_back(change.Pose(pose));
+    for (const ObjectTrack3D& object : bundle.ground_truth->objects) {
+      ObjectTrack3D moved{object.name, {}};
+      for (const Eigen::Vector3d& p : object.positions_m)
+        moved.positions_m.push_back(change.Point(p));
+      view.objects.push_back(std::move(moved));
+    }
     view.residual_px.assign(bundle.num_frames(), 0.5);
     view.summary.camera_model =
         bundle.views[k].cameras.size() == 1 ? "static" : "moving";

@@ -67,6 +67,14 @@ Eigen::Matrix<double, 2, 3> PinholeCamera::ProjectJacobian(
   return d_pixel_d_camera * rotation_;
 }
 
+Eigen::Vector3d PinholeCamera::RayDirectionWorld(
+    const Eigen::Vector2d& pixel_px) const {
+  const Eigen::Vector3d direction_camera(
+      (pixel_px.x() - intrinsics_.cx_px) / intrinsics_.fx_px,
+      (pixel_px.y() - intrinsics_.cy_px) / intrinsics_.fy_px, 1.0);
+  return rotation_.transpose() * direction_camera;
+}
+
 PinholeCamera PinholeCamera::Translated(const Eigen::Vector3d& offset_m) const {
   // Centre c' = c + offset, so t' = -R c' = t - R offset.
   return PinholeCamera(intrinsics_, rotation_,

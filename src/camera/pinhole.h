@@ -62,6 +62,9 @@ class PinholeCamera {
   Eigen::Vector3d CenterWorld() const {
     return -rotation_.transpose() * translation_m_;
   }
+  // The world direction (not normalized; unit depth along the optical axis)
+  // of the ray from the camera centre through `pixel_px`.
+  Eigen::Vector3d RayDirectionWorld(const Eigen::Vector2d& pixel_px) const;
   // The same camera moved by `offset_m` in the world (orientation kept).
   PinholeCamera Translated(const Eigen::Vector3d& offset_m) const;
 

@@ -1,6 +1,9 @@
 // cli: `mimic2d clip` — make, convert and inspect 2D clips and bundles.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -12,6 +15,8 @@
 #include "common/file_io.h"
 #include "motion/bundle.h"
 #include "motion/clip_io.h"
+#include "sim/character.h"
+#include "sim/object_replay.h"
 
 namespace m2d::cli {
 namespace {
@@ -22,7 +27,84 @@ struct FromMotionArgs {
   std::string cameras_output;
   BundleFromMotionOptions options;
   bool follow = false;
+  std::string ball;  // "", "auto" or "X,Y" (m)
 };
+
+// A ball's 3D truth for `sampled` (the bundle's frames): the character's
+// `ball` scene replays the motion kinematically with the ball starting at
+// rest where `where` says ("auto": in the path of the fastest kick, else
+// "X,Y" on the floor, m). Reports where it went; InputError when the
+// motion never touches it.
+std::vector<ObjectTrack3D> KickedBall(const MotionSourceArgs& source,
+                                      const Motion3D& sampled,
+                                      const std::string& where) {
+  const std::string extension =
+      std::filesystem::path(source.path).extension().string();
+  if (extension == ".bvh" || extension == ".BVH") {
+    throw ConfigError("--ball replays the motion on the character: " +
+                      source.path + " (BVH) is not in its skeleton");
+  }
+  const std::string config = AssetArgumentPath(
+      source.character.empty() ? "characters/humanoid.yaml" : source.character);
+  // Four physics steps a frame, as training's 120 Hz at 30 fps.
+  auto character = Character::Load(config, "ball", 1.0 / (4.0 * sampled.fps));
+  if (character->free_objects().size() != 1) {
+    throw InputError(character->model_path(),
+                     "--ball needs a scene with one free object, it has " +
+                         std::to_string(character->free_objects().size()));
+  }
+  const double radius_m = character->free_objects().front().radius_m;
+  if (!(radius_m > 0)) {
+    throw InputError(character->model_path(),
+                     "the scene's free object has no sphere: not a ball");
+  }
+  Eigen::Vector3d start_m;
+  if (where == "auto") {
+    const BallPlacement placement =
+        PlaceBallInFootPath(*character, sampled, radius_m);
+    start_m = placement.center_m;
+    std::printf(
+        "ball: placed at (%.2f, %.2f) m, ahead of %s at frame %d (%.1f m/s)\n",
+        start_m.x(), start_m.y(),
+        mj_id2name(character->model(), mjOBJ_BODY, placement.foot_body),
+        placement.frame, placement.foot_speed_m_s);
+  } else {
+    double x = 0, y = 0;
+    char rest = 0;
+    if (std::sscanf(where.c_str(), "%lf,%lf%c", &x, &y, &rest) != 2 ||
+        !std::isfinite(x) || !std::isfinite(y)) {
+      throw ConfigError("--ball: '" + where +
+                        "' is neither auto nor X,Y in metres");
+    }
+    start_m = {x, y, radius_m};
+  }
+  std::vector<ObjectTrack3D> tracks =
+      ReplayObjectsAlongMotion(*character, sampled, {start_m});
+  const std::vector<Eigen::Vector3d>& path = tracks.front().positions_m;
+  double top_speed_m_s = 0.0;
+  int kicked = -1;
+  for (size_t t = 1; t < path.size(); ++t) {
+    const double speed = (path[t] - path[t - 1]).norm() * sampled.fps;
+    if (speed > 0.5 && kicked < 0) kicked = static_cast<int>(t) - 1;
+    top_speed_m_s = std::max(top_speed_m_s, speed);
+  }
+  if (kicked < 0) {
+    throw InputError(source.path,
+                     "the ball at (" + std::to_string(start_m.x()) + ", " +
+                         std::to_string(start_m.y()) +
+                         ") m is never kicked: the motion does not reach "
+                         "it (give --ball X,Y where a foot passes)");
+  }
+  double top_height_m = 0.0;
+  for (const Eigen::Vector3d& p : path)
+    top_height_m = std::max(top_height_m, p.z() - radius_m);
+  std::printf(
+      "ball: kicked at frame %d, up to %.1f m/s and %.2f m off the floor; "
+      "at (%.2f, %.2f, %.2f) m at the end\n",
+      kicked, top_speed_m_s, top_height_m, path.back().x(), path.back().y(),
+      path.back().z());
+  return tracks;
+}
 
 struct ConvertArgs {
   std::string input;
@@ -35,8 +117,14 @@ int RunFromMotion(FromMotionArgs& args) {
       args.follow ? CameraFollow::kRootDolly : CameraFollow::kStatic;
   LoadedMotion loaded = LoadMotionSource(args.source);
   std::string name = std::filesystem::path(args.source.path).stem().string();
+  std::vector<ObjectTrack3D> objects;
+  if (!args.ball.empty()) {
+    objects = KickedBall(args.source,
+                         SampleMotionForBundle(loaded.motion, args.options),
+                         args.ball);
+  }
   ReferenceBundle bundle = MakeBundleFromMotion(
-      loaded.motion, loaded.keypoint_map, args.options, name);
+      loaded.motion, loaded.keypoint_map, args.options, name, objects);
   WriteBundle(args.output, bundle);
   if (!args.cameras_output.empty()) {
     std::vector<NamedCamera> cameras;
@@ -133,6 +221,11 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
   from_motion->add_option("--cameras-output", from->cameras_output,
                           "Also write the rig as a camera set (JSON)");
   AddBundleOptions(*from_motion, &from->options, &from->follow);
+  from_motion->add_option(
+      "--ball", from->ball,
+      "Add a ball the motion kicks (the character's 'ball' scene; its 3D "
+      "truth simulated with the character replaying the motion): auto (in "
+      "the path of the fastest foot near the floor) or X,Y on the floor (m)");
   from_motion->callback(
       [run, from] { *run = [from] { return RunFromMotion(*from); }; });
 

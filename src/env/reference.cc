@@ -7,6 +7,7 @@
 #include "common/error.h"
 #include "common/hash.h"
 #include "motion/canonical.h"
+#include "motion/object_track.h"
 #include "sim/pose_mapping.h"
 
 namespace m2d {
@@ -38,11 +39,7 @@ Pose3D PlaceDefaultPose(const Character& character, const Pose3D& standing,
                  &scale_m);
   // The ray through the 2D root, in world coordinates.
   const Intrinsics& k = camera.intrinsics();
-  Eigen::Vector3d direction_camera((image.root_px.x() - k.cx_px) / k.fx_px,
-                                   (image.root_px.y() - k.cy_px) / k.fy_px,
-                                   1.0);
-  Eigen::Vector3d direction =
-      camera.rotation_world_to_camera().transpose() * direction_camera;
+  const Eigen::Vector3d direction = camera.RayDirectionWorld(image.root_px);
   Eigen::Vector3d centre = camera.CenterWorld();
   // Meet the plane at the standing root height; for a ray nearly parallel to
   // the floor, use the depth at which the 3D spread has the 2D scale.
@@ -94,6 +91,89 @@ void AddJointNoise(double sigma_rad, std::mt19937_64& rng,
                  simulation);
 }
 
+// The 3D track named `name` in `tracks`; null when there is none.
+const ObjectTrack3D* FindObject(const std::vector<ObjectTrack3D>& tracks,
+                                const std::string& name) {
+  for (const ObjectTrack3D& track : tracks) {
+    if (track.name == name) return &track;
+  }
+  return nullptr;
+}
+
+// The 3D tracks of the reference's objects (object point order) that a
+// buffer's starts take their objects from: the truth's, the view's
+// estimate's, or (default) the view's 2D put on the floor through its
+// cameras (RollingObjectFromPixels).
+std::vector<ObjectTrack3D> StartObjectTracks(const ReferenceBundle& bundle,
+                                             int view,
+                                             InitialStateSource source,
+                                             const Character& character) {
+  std::vector<ObjectTrack3D> tracks;
+  const ReferenceView& reference_view = bundle.views[view];
+  for (const ObjectTrack2D& object : reference_view.clip.objects) {
+    const ObjectTrack3D* found = nullptr;
+    switch (source) {
+      case InitialStateSource::kTruth:
+        found = FindObject(bundle.ground_truth->objects, object.name);
+        break;
+      case InitialStateSource::kEstimate:
+        found = FindObject((*bundle.estimate)[view].objects, object.name);
+        break;
+      case InitialStateSource::kDefault: {
+        RollingBall ball;
+        for (const FreeObject& free : character.free_objects()) {
+          if (free.name == object.name) ball.radius_m = free.radius_m;
+        }
+        tracks.push_back(RollingObjectFromPixels(
+            object, reference_view.cameras, bundle.fps, ball, bundle.name));
+        continue;
+      }
+    }
+    tracks.push_back(*found);  // SanitizeBundle checked that it exists
+  }
+  return tracks;
+}
+
+// Puts each free object of `tracks` (object point order; `object_bodies`
+// their model bodies) at frame `t`, moving at the track's central
+// differences; an object within 1 cm of resting on the floor also spins as
+// a ball rolling without slipping.
+void PlaceObjects(const std::vector<ObjectTrack3D>& tracks,
+                  const std::vector<int>& object_bodies, int t, double dt_s,
+                  Simulation& simulation) {
+  if (tracks.empty()) return;  // the state stays exactly as set
+  const Character& character = simulation.character();
+  mjData* data = simulation.mutable_data();
+  for (size_t o = 0; o < tracks.size(); ++o) {
+    const FreeObject* object = nullptr;
+    for (const FreeObject& free : character.free_objects()) {
+      if (free.body_id == object_bodies[o]) object = &free;
+    }
+    const std::vector<Eigen::Vector3d>& path = tracks[o].positions_m;
+    const int previous = std::max(t - 1, 0);
+    const int next = std::min(t + 1, static_cast<int>(path.size()) - 1);
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    if (next > previous)
+      velocity = (path[next] - path[previous]) / ((next - previous) * dt_s);
+    double* qpos = data->qpos + object->qpos_address;
+    double* qvel = data->qvel + object->dof_address;
+    for (int i = 0; i < 3; ++i) {
+      qpos[i] = path[t][i];
+      qvel[i] = velocity[i];
+      qvel[3 + i] = 0.0;
+    }
+    qpos[3] = 1.0;
+    qpos[4] = qpos[5] = qpos[6] = 0.0;
+    if (object->radius_m > 0 && path[t].z() < object->radius_m + 0.01) {
+      // Rolling: omega = z x v / r (a free joint's angular velocity is in
+      // the body frame, which is the world's at the identity orientation).
+      qvel[3] = -velocity.y() / object->radius_m;
+      qvel[4] = velocity.x() / object->radius_m;
+    }
+  }
+  simulation.Refresh();
+}
+
 // Keeps of `bundle` only what `sources` allow downstream (see Prepare);
 // InputError naming the bundle when a source is missing.
 void SanitizeBundle(const Character& character, const TaskSources& sources,
@@ -126,6 +206,15 @@ void SanitizeBundle(const Character& character, const TaskSources& sources,
                                          "': initial_states: truth cannot "
                                          "replay them");
     }
+    for (const ObjectTrack2D& object : bundle->views.front().clip.objects) {
+      if (FindObject(truth->objects, object.name) == nullptr) {
+        throw InputError(bundle->name,
+                         "initial_states: truth needs the 3D of object '" +
+                             object.name +
+                             "' and the ground truth has none (use "
+                             "initial_states: estimate after mimic2d fit)");
+      }
+    }
   } else {
     bundle->ground_truth.reset();
   }
@@ -151,6 +240,15 @@ void SanitizeBundle(const Character& character, const TaskSources& sources,
                              " is of skeleton '" + estimate.skeleton_name +
                              "', the character's is '" + skeleton +
                              "': fit it again for this character");
+      }
+      for (const ObjectTrack2D& object : bundle->views[v].clip.objects) {
+        if (FindObject(estimate.objects, object.name) == nullptr) {
+          throw InputError(bundle->name,
+                           "the estimate of view " + bundle->views[v].name +
+                               " has no 3D of object '" + object.name +
+                               "': fit it again (mimic2d fit "
+                               "places the objects)");
+        }
       }
     }
   } else {
@@ -373,6 +471,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
     const ReferenceBundle& bundle = reference.bundles()[view.bundle];
     StateBuffer buffer(bundle.num_frames(), options);
     std::vector<BodyTarget3D> motion(bundle.num_frames());
+    const std::vector<ObjectTrack3D> object_tracks =
+        StartObjectTracks(bundle, view.view, source, *character);
     for (int t = 0; t < bundle.num_frames(); ++t) {
       simulation.Reset();
       switch (source) {
@@ -393,6 +493,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
               bundle.views[view.view].CameraAt(t), view.normalization[t]));
           break;
       }
+      PlaceObjects(object_tracks, reference.object_bodies(), t, dt_s,
+                   simulation);
       simulation.KeypointPositions(keypoints_xyz.data());
       ReadBodyTarget(simulation, keypoints_xyz.data(), &motion[t]);
       if (joint_noise_rad > 0)

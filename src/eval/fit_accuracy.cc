@@ -120,9 +120,23 @@ FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
                        std::to_string(truth.keypoints_m.front().size()));
     }
   }
+  double yaw_rad = 0.0;
   accuracy.root_relative_mpjpe_mm =
-      1000.0 *
-      YawAlignedRootRelativeError(fitted, truth.keypoints_m, *truth.layout);
+      1000.0 * YawAlignedRootRelativeError(fitted, truth.keypoints_m,
+                                           *truth.layout, &yaw_rad);
+  double object_sum_m = 0.0;
+  int num_objects = 0;
+  for (const ObjectTrack3D& ours : estimate.objects) {
+    for (const ObjectTrack3D& theirs : truth.objects) {
+      if (theirs.name != ours.name) continue;
+      object_sum_m +=
+          YawAlignedObjectError(fitted, ours.positions_m, truth.keypoints_m,
+                                theirs.positions_m, *truth.layout, yaw_rad);
+      ++num_objects;
+    }
+  }
+  if (num_objects > 0)
+    accuracy.object_error_mm = 1000.0 * object_sum_m / num_objects;
   accuracy.pa_mpjpe_mm =
       1000.0 * ProcrustesAlignedError(fitted, truth.keypoints_m);
   accuracy.reachable_pa_mpjpe_mm = 1000.0 * ReachableFloorM(truth, character);
@@ -160,6 +174,15 @@ FitAccuracy MeanFitAccuracy(const std::vector<FitAccuracy>& accuracies) {
     mean.unconverged_fraction += a.unconverged_fraction / n;
     mean.cpu_seconds_per_100_frames += a.cpu_seconds_per_100_frames / n;
   }
+  // Objects: the mean over the accuracies that measured one.
+  int with_objects = 0;
+  double object_sum_mm = 0.0;
+  for (const FitAccuracy& a : accuracies) {
+    if (a.object_error_mm < 0) continue;
+    object_sum_mm += a.object_error_mm;
+    ++with_objects;
+  }
+  if (with_objects > 0) mean.object_error_mm = object_sum_mm / with_objects;
   mean.num_frames = static_cast<int>(std::lround(frames / n));
   return mean;
 }
@@ -176,6 +199,10 @@ std::string FitAccuracy::BriefReport() const {
       reachable_pa_mpjpe_mm, mean_reprojection_px, seconds_per_100_frames,
       100.0 * unconverged_fraction);
   std::string report = line;
+  if (object_error_mm >= 0) {
+    std::snprintf(line, sizeof(line), ", object %.0f mm", object_error_mm);
+    report += line;
+  }
   if (cpu_seconds_per_100_frames > 0) {
     std::snprintf(line, sizeof(line), " (CPU %.1f s per 100 frames)",
                   cpu_seconds_per_100_frames);

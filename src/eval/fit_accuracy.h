@@ -38,6 +38,11 @@ struct FitAccuracy {
   // clip may bend joints further than the simulated character can; the
   // fit holds its poses inside the ranges). 0 without true poses.
   double reachable_pa_mpjpe_mm = 0.0;
+  // Objects (a ball): the fitted centre's offset from the character's root
+  // against the truth's, after the root-relative error's rotation about z
+  // (YawAlignedObjectError), mean over objects and frames, in millimetres;
+  // -1 when the truth or the estimate has no objects.
+  double object_error_mm = -1.0;
   // From the fit's summary: confidence-weighted mean reprojection (px), wall
   // time scaled to 100 frames (s), share of frames that did not converge.
   double mean_reprojection_px = 0.0;

@@ -77,6 +77,28 @@ double YawAlignedRootRelativeError(const KeypointFrames& simulated,
   return MeanPositionError(relative_sim, relative_true);
 }
 
+double YawAlignedObjectError(
+    const KeypointFrames& simulated,
+    const std::vector<Eigen::Vector3d>& simulated_object,
+    const KeypointFrames& truth,
+    const std::vector<Eigen::Vector3d>& true_object,
+    const KeypointLayout& layout, double yaw_rad) {
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const size_t num_frames =
+      std::min({simulated.size(), truth.size(), simulated_object.size(),
+                true_object.size()});
+  if (num_frames == 0) return 0.0;
+  double sum = 0.0;
+  for (size_t t = 0; t < num_frames; ++t) {
+    const Eigen::Vector3d ours =
+        rotation * (simulated_object[t] - Root(simulated[t], layout));
+    const Eigen::Vector3d theirs = true_object[t] - Root(truth[t], layout);
+    sum += (ours - theirs).norm();
+  }
+  return sum / num_frames;
+}
+
 double ProcrustesAlignedError(const KeypointFrames& simulated,
                               const KeypointFrames& truth) {
   double sum = 0.0;

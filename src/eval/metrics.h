@@ -33,6 +33,17 @@ double YawAlignedRootRelativeError(const KeypointFrames& simulated,
                                    const KeypointLayout& layout,
                                    double* yaw_rad = nullptr);
 
+// An object's error in worlds whose headings differ: per frame, its offset
+// from the character's root (mean of the layout's root keypoints) turned by
+// `yaw_rad` (YawAlignedRootRelativeError's rotation of the same worlds)
+// against the truth's offset; the mean distance (metres).
+double YawAlignedObjectError(
+    const KeypointFrames& simulated,
+    const std::vector<Eigen::Vector3d>& simulated_object,
+    const KeypointFrames& truth,
+    const std::vector<Eigen::Vector3d>& true_object,
+    const KeypointLayout& layout, double yaw_rad);
+
 // PA-MPJPE: per frame, the similarity transform (rotation, translation,
 // scale; Umeyama) that best maps the simulated keypoints onto the truth's,
 // then the mean distance (metres): pose error alone.

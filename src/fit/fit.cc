@@ -19,6 +19,7 @@
 #include "fit/pose_prior.h"
 #include "fit/pose_prior_training.h"
 #include "motion/canonical.h"
+#include "motion/object_track.h"
 #include "sim/character.h"
 #include "sim/pose_mapping.h"
 
@@ -1163,6 +1164,19 @@ ContactWeights CurrentContacts(const Observations& obs,
   return EstimateContacts(points, model, options, obs.fps, true, &feet);
 }
 
+// The clip's objects in the estimate's world: each on the floor under the
+// fitted cameras (RollingObjectFromPixels).
+void PlaceObjects(const Clip2D& clip, const FitOptions& options,
+                  const std::string& source, ViewEstimate* estimate) {
+  estimate->objects.clear();
+  const RollingBall ball{options.object_radius_m,
+                         options.object_deceleration_m_s2};
+  for (const ObjectTrack2D& track : clip.objects) {
+    estimate->objects.push_back(RollingObjectFromPixels(
+        track, estimate->cameras, clip.fps, ball, source));
+  }
+}
+
 ViewEstimate SolvePoseAndReport(const Observations& obs,
                                 const KinematicModel& model,
                                 const KeypointLayout& layout,
@@ -1508,8 +1522,11 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
                                               search_started)
                     .count()));
   }
-  return SolvePoseAndReport(obs, model, *clip.layout, character, options,
-                            priors, started, summary, best);
+  ViewEstimate estimate =
+      SolvePoseAndReport(obs, model, *clip.layout, character, options, priors,
+                         started, summary, best);
+  PlaceObjects(clip, options, source, &estimate);
+  return estimate;
 }
 
 ViewEstimate RefineView(const Clip2D& clip, const Character& character,
@@ -1537,8 +1554,11 @@ ViewEstimate RefineView(const Clip2D& clip, const Character& character,
   summary.initial_cost = SolveStage(Stage::kPose, 0, obs, model, *clip.layout,
                                     options, priors, nullptr, params)
                              .initial_cost;
-  return SolvePoseAndReport(obs, model, *clip.layout, character, options,
-                            priors, started, summary, params);
+  ViewEstimate estimate =
+      SolvePoseAndReport(obs, model, *clip.layout, character, options, priors,
+                         started, summary, params);
+  PlaceObjects(clip, options, source, &estimate);
+  return estimate;
 }
 
 FitTermCosts ExplainCost(const Clip2D& clip, const Character& character,

@@ -177,6 +177,13 @@ struct FitOptions {
   // Input checks: a clip needs this many frames; a usable frame this many
   // confident keypoints; the person at least this size (px, RMS spread);
   // at least this fraction of the frames usable.
+  // Objects (a clip's object tracks, e.g. a ball) are placed after the
+  // character, on the plane one radius above the floor under the fitted
+  // camera: a rolling ball (motion/object_track.h). A size-5 soccer ball's
+  // radius, as assets/characters/soccer_ball.xml.
+  double object_radius_m = 0.11;
+  double object_deceleration_m_s2 = 0.45;  // rolling on out of the image
+
   int min_frames = 8;
   int min_keypoints_per_frame = 6;
   double min_person_scale_px = 8.0;
@@ -289,6 +296,11 @@ struct FitOptions {
       Range::Above(0),
       "a frame with mean error above this many person sizes did not "
       "converge");
+    v("object_radius_m", self.object_radius_m, Range::Above(0),
+      "tracked objects are balls of this radius rolling on the floor (m)");
+    v("object_deceleration_m_s2", self.object_deceleration_m_s2,
+      Range::Above(0),
+      "a ball that left the image rolls on, slowing by this (m/s^2)");
     v("min_frames", self.min_frames, Range::AtLeast(3),
       "a clip needs this many frames");
     v("min_keypoints_per_frame", self.min_keypoints_per_frame,

@@ -65,6 +65,35 @@ std::vector<Pose3D> PosesFromJson(const JsonCursor& poses, long num_frames) {
   return out;
 }
 
+// Objects as [{name, positions_m: T x 3}] (ground truth and estimate share
+// the form).
+nlohmann::json ObjectsToJson(const std::vector<ObjectTrack3D>& objects) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const ObjectTrack3D& object : objects) {
+    nlohmann::json positions = nlohmann::json::array();
+    for (const Eigen::Vector3d& p : object.positions_m)
+      positions.push_back(Vector3ToJson(p));
+    json.push_back({{"name", object.name}, {"positions_m", positions}});
+  }
+  return json;
+}
+
+std::vector<ObjectTrack3D> ObjectsFromJson(const JsonCursor& cursor) {
+  std::vector<ObjectTrack3D> objects;
+  const size_t count = cursor.ArraySize();
+  for (size_t i = 0; i < count; ++i) {
+    JsonCursor entry = cursor.At(i);
+    ObjectTrack3D object;
+    object.name = entry.Field("name").String();
+    JsonCursor positions = entry.Field("positions_m");
+    const size_t num_frames = positions.ArraySize();
+    for (size_t t = 0; t < num_frames; ++t)
+      object.positions_m.push_back(Vector3FromJson(positions.At(t)));
+    objects.push_back(std::move(object));
+  }
+  return objects;
+}
+
 nlohmann::json GroundTruthToJson(const GroundTruth3D& truth) {
   nlohmann::json keypoints = nlohmann::json::array();
   for (const auto& frame : truth.keypoints_m) {
@@ -78,6 +107,7 @@ nlohmann::json GroundTruthToJson(const GroundTruth3D& truth) {
     json["skeleton"] = truth.skeleton_name;
     json["poses"] = PosesToJson(truth.poses);
   }
+  if (!truth.objects.empty()) json["objects"] = ObjectsToJson(truth.objects);
   return json;
 }
 
@@ -103,6 +133,8 @@ GroundTruth3D GroundTruthFromJson(const JsonCursor& cursor) {
     truth.poses =
         PosesFromJson(cursor.Field("poses"), static_cast<long>(num_frames));
   }
+  if (cursor.Has("objects"))
+    truth.objects = ObjectsFromJson(cursor.Field("objects"));
   return truth;
 }
 
@@ -156,6 +188,8 @@ nlohmann::json EstimateToJson(const std::vector<ViewEstimate>& estimate,
                        {"poses", PosesToJson(view.poses)},
                        {"residual_px", view.residual_px},
                        {"summary", SummaryToJson(view.summary)}});
+    if (!view.objects.empty())
+      entries.back()["objects"] = ObjectsToJson(view.objects);
   }
   return {{"views", entries}};
 }
@@ -186,6 +220,8 @@ std::vector<ViewEstimate> EstimateFromJson(
     for (size_t t = 0; t < num_residuals; ++t)
       view.residual_px.push_back(residuals.At(t).Number());
     view.summary = SummaryFromJson(entry.Field("summary"));
+    if (entry.Has("objects"))
+      view.objects = ObjectsFromJson(entry.Field("objects"));
     estimate.push_back(std::move(view));
   }
   return estimate;
@@ -197,6 +233,54 @@ bool PoseIsFinite(const Pose3D& pose) {
     if (!q.coeffs().allFinite()) return false;
   }
   return true;
+}
+
+// 3D object tracks (`where`: "ground truth" or a view's estimate) each name
+// one of `clip`'s 2D objects, once, with `num_frames` finite positions.
+void ValidateObjects(const std::vector<ObjectTrack3D>& objects,
+                     const Clip2D& clip, int num_frames,
+                     const std::string& source, const std::string& where) {
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const ObjectTrack3D& object = objects[i];
+    const std::string what = where + " object '" + object.name + "'";
+    bool tracked = false;
+    for (const ObjectTrack2D& track : clip.objects)
+      tracked = tracked || track.name == object.name;
+    if (!tracked)
+      throw InputError(source, what + " has no 2D track in the clips");
+    for (size_t k = 0; k < i; ++k) {
+      if (objects[k].name == object.name)
+        throw InputError(source, what + " appears twice");
+    }
+    if (static_cast<int>(object.positions_m.size()) != num_frames) {
+      throw InputError(source, what + " has " +
+                                   std::to_string(object.positions_m.size()) +
+                                   " positions, clips have " +
+                                   std::to_string(num_frames) + " frames");
+    }
+    for (int t = 0; t < num_frames; ++t) {
+      if (!object.positions_m[t].allFinite()) {
+        throw InputError(
+            source, what + ": frame " + std::to_string(t) + " is not finite");
+      }
+    }
+  }
+}
+
+// `point_m` as a detector reports it in `camera`'s image: projected
+// (confidence 0 behind the camera), then corrupted by `noise`.
+void ProjectAsDetected(const PinholeCamera& camera,
+                       const Eigen::Vector3d& point_m,
+                       const DetectorNoiseOptions& noise, std::mt19937_64& rng,
+                       std::normal_distribution<double>& unit_normal,
+                       std::uniform_real_distribution<double>& unit_uniform,
+                       Keypoint2D* keypoint) {
+  const Projection projection = camera.Project(point_m);
+  keypoint->x_px = projection.pixel_px.x();
+  keypoint->y_px = projection.pixel_px.y();
+  keypoint->confidence = projection.in_front ? 1.0 : 0.0;
+  CorruptKeypoint(noise.pixel_sigma_px, noise.drop_probability, rng,
+                  unit_normal, unit_uniform, keypoint);
 }
 
 }  // namespace
@@ -273,6 +357,8 @@ void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
           throw InputError(source, where + ": a camera is not finite");
         }
       }
+      ValidateObjects(view.objects, bundle.views[k].clip, num_frames, source,
+                      where);
       const FitSummary& summary = view.summary;
       if (!std::isfinite(summary.initial_cost) ||
           !std::isfinite(summary.final_cost) ||
@@ -295,6 +381,8 @@ void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
       throw InputError(source,
                        "ground-truth poses do not match the frame count");
     }
+    ValidateObjects(truth.objects, bundle.views.front().clip, num_frames,
+                    source, "ground truth");
   }
 }
 
@@ -483,14 +571,8 @@ std::vector<Eigen::Vector3d> SmoothedGroundPath(
 
 }  // namespace
 
-ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
-                                     const KeypointMap& keypoint_map,
-                                     const BundleFromMotionOptions& options,
-                                     const std::string& name) {
-  // Outline: loop/resample the motion to the clip rate, run FK for the 3D
-  // keypoints, place the rig at the start root (or the path's middle), project
-  // per view (moving the camera with the subject when following), add detector
-  // noise.
+Motion3D SampleMotionForBundle(const Motion3D& motion,
+                               const BundleFromMotionOptions& options) {
   options.Validate();
   Motion3D sampled =
       ExtendLoop(motion, options.duration_s, options.loop_heading);
@@ -501,7 +583,28 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
         1;
     if (wanted < sampled.num_frames()) sampled.frames.resize(wanted);
   }
+  return sampled;
+}
+
+ReferenceBundle MakeBundleFromMotion(
+    const Motion3D& motion, const KeypointMap& keypoint_map,
+    const BundleFromMotionOptions& options, const std::string& name,
+    const std::vector<ObjectTrack3D>& objects) {
+  // Outline: loop/resample the motion to the clip rate, run FK for the 3D
+  // keypoints, place the rig at the start root (or the path's middle), project
+  // per view (moving the camera with the subject when following), add detector
+  // noise; the same for the objects' centres.
+  const Motion3D sampled = SampleMotionForBundle(motion, options);
   if (sampled.num_frames() < 1) throw InputError(name, "motion has no frames");
+  for (const ObjectTrack3D& object : objects) {
+    if (static_cast<int>(object.positions_m.size()) != sampled.num_frames()) {
+      throw InputError(name, "object '" + object.name + "' has " +
+                                 std::to_string(object.positions_m.size()) +
+                                 " positions for " +
+                                 std::to_string(sampled.num_frames()) +
+                                 " frames");
+    }
+  }
 
   ReferenceBundle bundle;
   bundle.name = name;
@@ -514,6 +617,7 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
         KeypointPositions(*motion.skeleton, keypoint_map, pose));
   }
   truth.poses = sampled.frames;
+  truth.objects = objects;
 
   RigOptions rig = options.rig;
   Eigen::Vector3d aim = sampled.frames.front().root_position_m;
@@ -530,6 +634,7 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
   }
 
   std::mt19937_64 rng(options.noise.seed);
+  std::mt19937_64 object_rng(options.noise.seed + 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   std::uniform_real_distribution<double> unit_uniform(0.0, 1.0);
   const int num_frames = sampled.num_frames();
@@ -558,15 +663,29 @@ ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
                     t + options.noise.time_jitter_frames * unit_normal(rng))
               : truth.keypoints_m[t];
       for (int j = 0; j < num_keypoints; ++j) {
-        Projection projection = camera.Project(points[j]);
-        Keypoint2D& keypoint = view.clip.keypoints.at(t, j);
-        keypoint.x_px = projection.pixel_px.x();
-        keypoint.y_px = projection.pixel_px.y();
-        keypoint.confidence = projection.in_front ? 1.0 : 0.0;
-        CorruptKeypoint(options.noise.pixel_sigma_px,
-                        options.noise.drop_probability, rng, unit_normal,
-                        unit_uniform, &keypoint);
+        ProjectAsDetected(camera, points[j], options.noise, rng, unit_normal,
+                          unit_uniform, &view.clip.keypoints.at(t, j));
       }
+    }
+    // The objects' 2D, with noise from their own stream, so that the
+    // keypoints draw the same noise with or without objects. A ball outside
+    // the image is not detected (confidence 0), as a detector would miss
+    // it; a kicked ball leaves the frame where the person does not.
+    for (const ObjectTrack3D& object : objects) {
+      ObjectTrack2D track;
+      track.name = object.name;
+      track.points.resize(num_frames);
+      for (int t = 0; t < num_frames; ++t) {
+        Keypoint2D& point = track.points[t];
+        ProjectAsDetected(view.CameraAt(t), object.positions_m[t],
+                          options.noise, object_rng, unit_normal, unit_uniform,
+                          &point);
+        if (!(point.x_px >= 0 && point.x_px < rig.width_px && point.y_px >= 0 &&
+              point.y_px < rig.height_px)) {
+          point.confidence = 0.0;
+        }
+      }
+      view.clip.objects.push_back(std::move(track));
     }
     bundle.views.push_back(std::move(view));
   }

@@ -30,6 +30,13 @@ struct ReferenceView {
   }
 };
 
+// A free object's centre (e.g. a ball's) in 3D, one per frame; `name` is
+// the 2D object track's (Clip2D::objects) it is the 3D of.
+struct ObjectTrack3D {
+  std::string name;
+  std::vector<Eigen::Vector3d> positions_m;  // T, world
+};
+
 // 3D truth behind a synthetic bundle, sampled at the bundle's frames.
 struct GroundTruth3D {
   const KeypointLayout* layout = &Coco17Layout();
@@ -38,6 +45,7 @@ struct GroundTruth3D {
   // skeleton they belong to, so a character can check it can replay them.
   std::string skeleton_name;
   std::vector<Pose3D> poses;
+  std::vector<ObjectTrack3D> objects;  // the objects' 3D, when they have 2D
 };
 
 // More than this share of a view's frames unconverged makes its fit
@@ -77,6 +85,9 @@ struct ViewEstimate {
   std::vector<Pose3D> poses;           // one per frame
   std::vector<double> residual_px;     // per frame: mean reprojection error
   FitSummary summary;
+  // The view's objects in its world frame (FitObjectTrack), one per 2D
+  // object track; empty for an estimate made before objects were fitted.
+  std::vector<ObjectTrack3D> objects;
 
   const PinholeCamera& CameraAt(int frame) const {
     return cameras.size() == 1 ? cameras[0] : cameras[frame];
@@ -105,7 +116,9 @@ inline constexpr int kBundleVersion = 2;
 // Checks that views agree on frame count and fps, that per-frame camera
 // lists match the clip length (none, 1 or T), that ground truth has the same
 // length, and that an estimate has one entry per view with 1 or T cameras,
-// T poses and T residuals, all finite. Errors name `source` and the view.
+// T poses and T residuals, all finite; 3D object tracks (truth or estimate)
+// name one of the first view's 2D objects each and have T finite positions.
+// Errors name `source` and the view.
 void ValidateBundle(const ReferenceBundle& bundle, const std::string& source);
 // Reads versions 1 and 2; writes version 2 (atomically).
 ReferenceBundle ReadBundle(const std::string& path);
@@ -167,13 +180,23 @@ struct BundleFromMotionOptions {
   void Validate() const;  // throws ConfigError
 };
 
+// `motion` at the bundle's frames: looped to `options.duration_s` (when a
+// looping motion is shorter), resampled to `options.fps`, cut to the
+// duration. What MakeBundleFromMotion renders, and what objects moving
+// with the motion (sim/object_replay.h) are simulated along.
+Motion3D SampleMotionForBundle(const Motion3D& motion,
+                               const BundleFromMotionOptions& options);
+
 // Renders `motion` into a multi-view bundle: forward kinematics to the
 // keypoint map's 3D keypoints, projection into each rig camera, optional
 // detector noise. Ground truth keeps the exact keypoints and poses.
-ReferenceBundle MakeBundleFromMotion(const Motion3D& motion,
-                                     const KeypointMap& keypoint_map,
-                                     const BundleFromMotionOptions& options,
-                                     const std::string& name);
+// `objects` (3D, at SampleMotionForBundle's frames) are projected into 2D
+// object tracks of every view, with the same detector noise, and kept in
+// the ground truth. InputError when their frame count differs.
+ReferenceBundle MakeBundleFromMotion(
+    const Motion3D& motion, const KeypointMap& keypoint_map,
+    const BundleFromMotionOptions& options, const std::string& name,
+    const std::vector<ObjectTrack3D>& objects = {});
 
 // Per-view figures for a one-screen summary.
 struct ViewSummary {

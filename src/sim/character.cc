@@ -416,6 +416,10 @@ void Character::CollectBodies() {
     object.body_id = body;
     object.qpos_address = m->jnt_qposadr[j];
     object.dof_address = m->jnt_dofadr[j];
+    for (int g = m->ngeom - 1; g >= 0; --g) {
+      if (m->geom_bodyid[g] == body && m->geom_type[g] == mjGEOM_SPHERE)
+        object.radius_m = m->geom_size[3 * g];
+    }
     free_objects_.push_back(object);
   }
 }

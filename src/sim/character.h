@@ -76,6 +76,7 @@ struct FreeObject {
   int body_id = -1;
   int qpos_address = -1;
   int dof_address = -1;
+  double radius_m = 0.0;  // its first sphere geom's; 0 without one
 };
 
 // A character in a compiled scene: the MuJoCo model plus every id and

@@ -1,4 +1,5 @@
-// The tracking task with an object: a ball tracked in 2D next to the walker.
+// The tracking task with an object: a ball tracked in 2D next to the walker,
+// and the starts that place it.
 #include <gtest/gtest.h>
 
 #include "common/error.h"
@@ -31,6 +32,9 @@ TEST(TrackingEnvWithObject, ObservesTheBallAndRewardsItsTracking) {
     }
     view.clip.objects.push_back(track);
   }
+  // Its 3D, which the truth's starts place it from.
+  bundle.ground_truth->objects = {
+      {"ball", std::vector<Eigen::Vector3d>(bundle.num_frames(), ball_m)}};
   auto reference = TrackingReference::Prepare({bundle}, *character,
                                               options.simulation.control_hz);
   EXPECT_EQ(reference->num_object_points(), 1);
@@ -72,6 +76,125 @@ TEST(TrackingEnvWithObject, AnUnknownObjectNameIsRejected) {
   }
   EXPECT_THROW(TrackingReference::Prepare({bundle}, *character, 30.0),
                InputError);
+}
+
+// A gliding humanoid and a ball kicked along +x at 0.3 s (3 m/s, rolling),
+// seen by 2 static views, with an estimate of each view in a world of its
+// own (the truth turned and shifted, as mimic2d fit's worlds are).
+ReferenceBundle GlidingWithRollingBall(const Character& character) {
+  const Pose3D standing = QposToPose(character, character.model()->qpos0);
+  BundleFromMotionOptions options;
+  options.rig.num_views = 2;
+  ReferenceBundle bundle = MakeBundleFromMotion(
+      testing::GlidingMotion(character.shared_skeleton(), standing, 1.0),
+      character.keypoint_map(), options, "gliding",
+      {testing::RollingBallTrack(31, 30.0, 0.3, 3.0, 0.11, 1.5, 1.0)});
+  bundle.estimate = testing::EstimateFromTruth(
+      bundle, {{0.4, {1.0, 2.0, 0.0}}, {-1.1, {0.0, -3.0, 0.0}}});
+  return bundle;
+}
+
+TEST(TrackingEnvWithObject, StartsPlaceTheBallFromEachSource) {
+  SimulationOptions simulation;
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      simulation);
+  const FreeObject& ball = character->free_objects()[0];
+  const ReferenceBundle bundle = GlidingWithRollingBall(*character);
+  const std::vector<Eigen::Vector3d>& truth =
+      bundle.ground_truth->objects[0].positions_m;
+  // Buffer `b`'s ball at frame t: position and linear velocity.
+  auto ball_at = [&](const InitialStates& states, int b, int t) {
+    const SimState& state = states.buffer(b).entry(t, 0).state;
+    return std::make_pair(
+        Eigen::Vector3d(state.qpos.data() + ball.qpos_address),
+        Eigen::Vector3d(state.qvel.data() + ball.dof_address));
+  };
+  auto starts = [&](InitialStateSource source, CameraSource cameras) {
+    TaskSources sources;
+    sources.initial_states = source;
+    sources.cameras = cameras;
+    auto reference = TrackingReference::Prepare({bundle}, *character,
+                                                simulation.control_hz, sources);
+    return std::make_shared<InitialStates>(*reference, character, simulation,
+                                           StateBufferOptions());
+  };
+
+  // Truth: the truth's ball, at rest before the kick, rolling after it at
+  // 3 m/s (spinning at v / r about y).
+  auto from_truth = starts(InitialStateSource::kTruth, CameraSource::kTruth);
+  for (int t : {0, 5, 20}) {
+    const auto [position, velocity] = ball_at(*from_truth, 0, t);
+    EXPECT_LT((position - truth[t]).norm(), 1e-9) << t;
+  }
+  EXPECT_LT(ball_at(*from_truth, 0, 5).second.norm(), 1e-9);
+  EXPECT_NEAR(ball_at(*from_truth, 0, 20).second.x(), 3.0, 1e-9);
+  const SimState& rolling = from_truth->buffer(0).entry(20, 0).state;
+  EXPECT_NEAR(rolling.qvel[ball.dof_address + 4], 3.0 / 0.11, 1e-9);
+
+  // Estimate: each view's ball, in that view's world.
+  auto from_estimate =
+      starts(InitialStateSource::kEstimate, CameraSource::kEstimate);
+  const std::vector<testing::WorldChange> changes = {{0.4, {1.0, 2.0, 0.0}},
+                                                     {-1.1, {0.0, -3.0, 0.0}}};
+  for (int view = 0; view < 2; ++view) {
+    for (int t : {0, 20}) {
+      EXPECT_LT((ball_at(*from_estimate, view, t).first -
+                 changes[view].Point(truth[t]))
+                    .norm(),
+                1e-9);
+    }
+  }
+
+  // Default: the first view's 2D put on the floor through its camera; a
+  // rolling ball's centre exactly wherever the view sees it (it leaves the
+  // image at 3 m/s: then it rolls on, slowing, as RollingObjectFromPixels
+  // says).
+  auto from_default =
+      starts(InitialStateSource::kDefault, CameraSource::kTruth);
+  int seen_rolling = 0;
+  for (int t = 0; t < bundle.num_frames(); ++t) {
+    if (!bundle.views[0].clip.objects[0].points[t].IsPresent()) continue;
+    EXPECT_LT((ball_at(*from_default, 0, t).first - truth[t]).norm(), 1e-6)
+        << t;
+    seen_rolling += t > 9;
+  }
+  EXPECT_GT(seen_rolling, 3);
+}
+
+TEST(TrackingEnvWithObject, StartsWithoutTheBallsThreeDAreNamedErrors) {
+  SimulationOptions simulation;
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      simulation);
+  ReferenceBundle bundle = GlidingWithRollingBall(*character);
+  bundle.ground_truth->objects.clear();
+  (*bundle.estimate)[1].objects.clear();
+  auto expect_error = [&](InitialStateSource source, CameraSource cameras,
+                          const std::string& needle) {
+    TaskSources sources;
+    sources.initial_states = source;
+    sources.cameras = cameras;
+    try {
+      TrackingReference::Prepare({bundle}, *character, simulation.control_hz,
+                                 sources);
+      ADD_FAILURE() << "expected InputError with " << needle;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("gliding"), std::string::npos);
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos)
+          << e.what();
+    }
+  };
+  expect_error(InitialStateSource::kTruth, CameraSource::kTruth,
+               "truth needs the 3D of object 'ball'");
+  expect_error(InitialStateSource::kEstimate, CameraSource::kEstimate,
+               "the estimate of view " + bundle.views[1].name +
+                   " has no 3D of object 'ball'");
+  // The default starts need no 3D of the ball: they place it from the 2D.
+  TaskSources sources;
+  sources.initial_states = InitialStateSource::kDefault;
+  EXPECT_NO_THROW(TrackingReference::Prepare({bundle}, *character,
+                                             simulation.control_hz, sources));
 }
 
 }  // namespace

@@ -221,6 +221,29 @@ TEST(YawAlignedRootRelativeError, AnErrorAfterAlignmentIsMeasured) {
               15.0 * 0.02 / 17, 1e-9);
 }
 
+TEST(YawAlignedObjectError, FollowsTheWorldsTurnAndMeasuresTheRest) {
+  const KeypointFrames truth = MakePoses(5);
+  const KeypointFrames simulated =
+      Transformed(truth, Yaw(2.5), 1.0, {3.0, -1.0, 0.0});
+  std::vector<Eigen::Vector3d> true_ball, simulated_ball;
+  for (int t = 0; t < 5; ++t) {
+    true_ball.emplace_back(1.0 + 0.2 * t, 0.5, 0.11);
+    simulated_ball.push_back(Yaw(2.5) * true_ball.back() +
+                             Eigen::Vector3d(3.0, -1.0, 0.0));
+  }
+  double yaw_rad = 0.0;
+  YawAlignedRootRelativeError(simulated, truth, Coco17Layout(), &yaw_rad);
+  EXPECT_NEAR(YawAlignedObjectError(simulated, simulated_ball, truth, true_ball,
+                                    Coco17Layout(), yaw_rad),
+              0.0, 1e-9);
+  // A ball 30 cm farther along every frame is 30 cm off.
+  for (Eigen::Vector3d& p : simulated_ball)
+    p += Yaw(2.5) * Eigen::Vector3d(0.3, 0, 0);
+  EXPECT_NEAR(YawAlignedObjectError(simulated, simulated_ball, truth, true_ball,
+                                    Coco17Layout(), yaw_rad),
+              0.3, 1e-9);
+}
+
 TEST(ProcrustesAlignedError, ARotatedScaledShiftedCopyHasNoError) {
   const KeypointFrames truth = MakePoses(6);
   // A different similarity per frame, rotations about every axis.
