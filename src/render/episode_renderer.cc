@@ -164,6 +164,41 @@ std::vector<Eigen::Vector3d> EpisodeRenderer::PlaceScene(
   return SimulatedKeypoints(simulation_);
 }
 
+void EpisodeRenderer::DrawObjects(const EpisodeFrame& frame,
+                                  const Eigen::Vector2d& corner, double zoom,
+                                  const OverlaySizes& reference_sizes,
+                                  const OverlaySizes& sizes,
+                                  OverlayCanvas& canvas) const {
+  // Rings a ball's size: its radius (or 0.11 m) at its depth, shown.
+  const std::vector<FreeObject>& objects = character_->free_objects();
+  const double shown = zoom * options_.scale;
+  const double fx_px = frame.camera.intrinsics().fx_px;
+  const size_t count = std::min(objects.size(), frame.reference_objects.size());
+  for (size_t o = 0; o < count; ++o) {
+    const double* x = simulation_.data()->xpos + 3 * objects[o].body_id;
+    const Projection projection = frame.camera.Project({x[0], x[1], x[2]});
+    const double radius_m =
+        objects[o].radius_m > 0 ? objects[o].radius_m : 0.11;
+    const double radius_px = projection.in_front
+                                 ? fx_px * radius_m / projection.depth_m * shown
+                                 : 0.0;
+    const Keypoint2D simulated = {projection.pixel_px.x(),
+                                  projection.pixel_px.y(),
+                                  projection.in_front ? 1.0 : 0.0};
+    const auto shown_point = [&](const Keypoint2D& point) {
+      return ScaleKeypoints(CropKeypoints({point}, corner, zoom),
+                            options_.scale)
+          .front();
+    };
+    canvas.DrawRing(shown_point(frame.reference_objects[o]),
+                    radius_px + reference_sizes.line_width_px,
+                    options_.reference_color, reference_sizes);
+    if (frame.state)
+      canvas.DrawRing(shown_point(simulated), radius_px, options_.pose_color,
+                      sizes);
+  }
+}
+
 RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
   // Outline: place the scene, draw it through the scaled camera, project
   // the pose, measure the 2D error, draw the overlays, add the side panel.
@@ -264,6 +299,8 @@ RenderedFrame EpisodeRenderer::Render(const EpisodeFrame& frame) {
       *layout_,
       ScaleKeypoints(CropKeypoints(pose_px, corner, zoom), options_.scale),
       options_.pose_color, sizes);
+  if (!frame.reference_objects.empty())
+    DrawObjects(frame, corner, zoom, reference_sizes, sizes, canvas);
   const double margin_px = 0.5 * sizes.font_size_px;
   canvas.DrawLabel({{"frame " + std::to_string(frame.clip_frame)},
                     {FormatE2d(rendered.e2d_px)},

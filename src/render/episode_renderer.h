@@ -17,6 +17,7 @@
 #include "motion/bundle.h"
 #include "motion/clip2d.h"
 #include "render/gl_camera.h"
+#include "render/overlay.h"
 #include "render/scene_renderer.h"
 #include "sim/simulation.h"
 
@@ -29,6 +30,10 @@ struct EpisodeFrame {
   PinholeCamera camera;  // at the clip's image size (scaling comes later)
   // The layout's keypoints in the clip's image pixels; empty: no reference.
   std::vector<Keypoint2D> reference;
+  // The tracked objects' reference (e.g. the ball's centre), clip pixels,
+  // in the scene's free-object order; drawn as rings beside the simulated
+  // objects' projections. Empty: no objects tracked.
+  std::vector<Keypoint2D> reference_objects;
   // The character's (and the scene's) state; nullopt: the scene without
   // the character.
   std::optional<SimState> state;
@@ -126,8 +131,9 @@ struct RenderedFrame {
 
 // Draws episode frames: the 3D scene through the frame's pinhole camera,
 // then the reference (green) and the pose's projected keypoints (red) as
-// skeletons, the frame number and 2D error in the top-left corner, and
-// optionally a free (orbit) camera panel on the right.
+// skeletons (tracked objects as rings of the same colours), the frame number
+// and 2D error in the top-left corner, and optionally a free (orbit) camera
+// panel on the right.
 class EpisodeRenderer {
  public:
   // Frames show `character`'s scene; their states are restored into the
@@ -151,6 +157,12 @@ class EpisodeRenderer {
  private:
   // The pose's 3D keypoints: restores the state (or hides the character).
   std::vector<Eigen::Vector3d> PlaceScene(const EpisodeFrame& frame);
+  // The frame's reference objects (rings, reference colour) and, with a
+  // state, the scene's simulated objects (rings, pose colour), cropped by
+  // `corner` and `zoom` and scaled as the skeletons are.
+  void DrawObjects(const EpisodeFrame& frame, const Eigen::Vector2d& corner,
+                   double zoom, const OverlaySizes& reference_sizes,
+                   const OverlaySizes& sizes, OverlayCanvas& canvas) const;
 
   std::shared_ptr<const Character> character_;
   const KeypointLayout* layout_;

@@ -56,6 +56,17 @@ void OverlayCanvas::DrawSkeleton(const KeypointLayout& layout,
   cairo_fill(cairo);
 }
 
+void OverlayCanvas::DrawRing(const Keypoint2D& point, double radius_px,
+                             Rgb color, const OverlaySizes& sizes) {
+  if (!point.IsPresent()) return;
+  cairo_t* cairo = cairo_.get();
+  SetColor(cairo, color);
+  cairo_set_line_width(cairo, sizes.line_width_px);
+  cairo_new_sub_path(cairo);
+  cairo_arc(cairo, point.x_px, point.y_px, radius_px, 0.0, 2.0 * M_PI);
+  cairo_stroke(cairo);
+}
+
 void OverlayCanvas::DrawLabel(const std::vector<LabelLine>& lines, double x_px,
                               double y_px, const OverlaySizes& sizes) {
   if (lines.empty()) return;

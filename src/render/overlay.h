@@ -42,6 +42,12 @@ class OverlayCanvas {
                     const std::vector<Keypoint2D>& keypoints, Rgb color,
                     const OverlaySizes& sizes);
 
+  // A circle of `radius_px` around `point` (an object's centre, e.g. a
+  // ball's), outlined with the skeleton's line width; nothing when the
+  // point is missing.
+  void DrawRing(const Keypoint2D& point, double radius_px, Rgb color,
+                const OverlaySizes& sizes);
+
   // Lines of text on a translucent dark box with its top-left corner at
   // (x, y).
   void DrawLabel(const std::vector<LabelLine>& lines, double x_px, double y_px,

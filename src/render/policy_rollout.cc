@@ -14,6 +14,16 @@ EpisodeFrame CurrentFrame(const TrackingEnv& env,
   frame.camera = bundle.views[view.view].CameraAt(env.frame());
   const Keypoint2D* points = view.frame(env.frame());
   frame.reference.assign(points, points + num_keypoints);
+  // The objects' reference in the scene's free-object order (missing where
+  // an object is not tracked).
+  const std::vector<int>& tracked = reference.object_bodies();
+  for (const FreeObject& object : env.simulation().character().free_objects()) {
+    Keypoint2D point;
+    for (size_t o = 0; o < tracked.size(); ++o) {
+      if (tracked[o] == object.body_id) point = points[num_keypoints + o];
+    }
+    if (!tracked.empty()) frame.reference_objects.push_back(point);
+  }
   frame.state = env.simulation().Save();
   return frame;
 }

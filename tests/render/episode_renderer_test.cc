@@ -87,6 +87,46 @@ TEST_F(EpisodeFrameTest, OverlaysLandOnTheProjectedAndReferencePixels) {
   }
 }
 
+// With a ball tracked: the reference's ball (green) and the simulated ball
+// (red) are rings a ball's size around their centres.
+TEST_F(EpisodeFrameTest, TrackedObjectsAreRingsAroundTheirCentres) {
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      SimulationOptions());
+  Simulation simulation(character, SimulationOptions());
+  const double* ball =
+      simulation.data()->xpos + 3 * character->free_objects()[0].body_id;
+  const Projection projection = camera_.Project({ball[0], ball[1], ball[2]});
+  const double radius_px = 600.0 * 0.11 / projection.depth_m;
+  EpisodeRenderOptions options;
+  options.subject_height_fraction = 0.0;  // no zoom: clip pixels are shown
+  EpisodeRenderer renderer(character, SimulationOptions(),
+                           character->keypoint_layout(), 640, 480, options);
+  EpisodeFrame frame;
+  frame.camera = camera_;
+  frame.state = simulation.Save();
+  // The reference ball 120 px left of the simulated one.
+  frame.reference_objects = {
+      {projection.pixel_px.x() - 120.0, projection.pixel_px.y(), 1.0}};
+  const RenderedFrame rendered = renderer.Render(frame);
+  const int y = static_cast<int>(std::floor(projection.pixel_px.y()));
+  EXPECT_EQ(
+      rendered.image.at(
+          static_cast<int>(std::floor(projection.pixel_px.x() + radius_px)), y),
+      options.pose_color);
+  // The reference ring is drawn wider, just outside the ball's size: some
+  // pixel within 10 px outside that radius is its colour; its centre is not.
+  const double reference_x = projection.pixel_px.x() - 120.0;
+  bool ring = false;
+  for (int dx = 0; dx <= 10; ++dx) {
+    const int x = static_cast<int>(std::floor(reference_x - radius_px - dx));
+    ring = ring || rendered.image.at(x, y) == options.reference_color;
+  }
+  EXPECT_TRUE(ring);
+  EXPECT_NE(rendered.image.at(static_cast<int>(std::floor(reference_x)), y),
+            options.reference_color);
+}
+
 // A subject far from the camera: the view zooms in until it fills half
 // the frame height, and the overlays follow the crop.
 TEST_F(EpisodeFrameTest, FramingZoomsInOnASmallSubject) {

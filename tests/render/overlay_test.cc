@@ -56,6 +56,21 @@ TEST(OverlayCanvas, DotsAndBonesLandOnTheirPixels) {
   EXPECT_LT(changed, 6000);
 }
 
+TEST(OverlayCanvas, ARingCirclesItsPointAndAMissingPointDrawsNothing) {
+  RgbImage image(400, 300, kGray);
+  OverlayCanvas canvas(&image);
+  canvas.DrawRing({200.5, 150.5, 1.0}, 40.0, kRed, OverlaySizes{4, 3, 12});
+  canvas.DrawRing({100.5, 100.5, 0.0}, 40.0, kRed, OverlaySizes{4, 3, 12});
+  canvas.Finish();
+  // On the circle: the colour; its centre and the missing point's: not.
+  EXPECT_EQ(image.at(240, 150), kRed);
+  EXPECT_EQ(image.at(160, 150), kRed);
+  EXPECT_EQ(image.at(200, 110), kRed);
+  EXPECT_EQ(image.at(200, 150), kGray);
+  EXPECT_EQ(image.at(60, 100), kGray);
+  EXPECT_EQ(image.at(100, 100), kGray);
+}
+
 TEST(OverlayCanvas, MissingKeypointsAndTheirBonesAreSkipped) {
   std::vector<Keypoint2D> points = StandingFigure();
   Keypoint2D& wrist = points[static_cast<int>(Coco17::kRightWrist)];
