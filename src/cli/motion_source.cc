@@ -177,6 +177,33 @@ void PrintBundleSummary(const ReferenceBundle& bundle,
                      " poses, from mimic2d fit)")
                         .c_str()
                   : "none");
+  for (const ObjectTrack2D& object : bundle.views.front().clip.objects) {
+    // The object's 3D, where the bundle holds it.
+    std::string where_3d;
+    auto has = [&](const std::vector<ObjectTrack3D>& tracks) {
+      for (const ObjectTrack3D& track : tracks) {
+        if (track.name == object.name) return true;
+      }
+      return false;
+    };
+    if (bundle.ground_truth && has(bundle.ground_truth->objects))
+      where_3d = "ground truth";
+    if (bundle.estimate && has(bundle.estimate->front().objects))
+      where_3d += where_3d.empty() ? "estimate" : ", estimate";
+    long seen = 0, total = 0;
+    for (const ReferenceView& view : bundle.views) {
+      for (const ObjectTrack2D& track : view.clip.objects) {
+        if (track.name != object.name) continue;
+        for (const Keypoint2D& point : track.points) {
+          seen += point.IsPresent();
+          ++total;
+        }
+      }
+    }
+    std::printf("  object: %s, seen in %.1f%% of the views' frames; 3D: %s\n",
+                object.name.c_str(), total > 0 ? 100.0 * seen / total : 0.0,
+                where_3d.empty() ? "none" : where_3d.c_str());
+  }
   std::printf("  %-8s %8s %10s %10s %12s %10s\n", "view", "frames", "present%",
               "in-image%", "height(px)", "fit(px)");
   const std::vector<ViewSummary> summaries = SummarizeBundle(bundle);

@@ -246,6 +246,11 @@ TEST(Cli, AKickedBallIsSimulatedProjectedAndFitted) {
       truth.ground_truth->objects[0].positions_m;
   EXPECT_GT((ball.back() - ball.front()).norm(), 1.0);  // it was kicked
   ASSERT_EQ(truth.views[0].clip.objects.size(), 1u);
+  result = RunMimic2d("clip info " + dir + "/truth.json");
+  EXPECT_NE(result.output.find("object: ball, seen in"), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("3D: ground truth"), std::string::npos)
+      << result.output;
 
   ASSERT_EQ(
       RunMimic2d("clip strip " + dir + "/truth.json -o " + dir + "/2d.json")
