@@ -230,6 +230,17 @@ BeforeAndAfter TrainAndEvaluateFrom2d(
   return result;
 }
 
+// `config` trains `character_asset` (a path under the repository) in
+// `scene`; returns that character, loaded for the config's simulation.
+std::shared_ptr<const Character> UseCharacter(
+    const std::string& character_asset, const std::string& scene,
+    TrainConfig* config) {
+  config->data.character_config = testing::SourcePath(character_asset);
+  config->data.scene = scene;
+  return LoadCharacterForSimulation(config->data.character_config, scene,
+                                    config->env.simulation);
+}
+
 // Calibrated on this machine (issue 11): the same run from 2D only — the
 // bundle stripped of its 3D truth and cameras, then fitted; training and
 // evaluation start from the fitted poses and project with the fitted
@@ -280,10 +291,7 @@ constexpr double kMinDogSurvivalGain = 1.3;  // measured 1.58x
 TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
   std::string dir = testing::TempDir("learning_dog");
   TrainConfig config;
-  config.data.character_config =
-      testing::SourcePath("assets/characters/dog.yaml");
-  auto character = LoadCharacterForSimulation(config.data.character_config,
-                                              "flat", config.env.simulation);
+  auto character = UseCharacter("assets/characters/dog.yaml", "flat", &config);
   BundleFromMotionOptions bundle_options;
   bundle_options.duration_s = 2.0;
   bundle_options.rig.num_views = 2;
@@ -323,12 +331,9 @@ constexpr double kMinBallSurvivalGain = 1.3;  // measured 1.72x
 TEST(Learning, PpoLearnsToWalkAndKickTheBallFromAStrippedAndFittedBundle) {
   std::string dir = testing::TempDir("learning_ball");
   TrainConfig config;
-  config.data.character_config =
-      testing::SourcePath("assets/characters/humanoid.yaml");
-  config.data.scene = "ball";
   config.env.reward.object_weight = 0.5;
-  auto character = LoadCharacterForSimulation(config.data.character_config,
-                                              "ball", config.env.simulation);
+  auto character =
+      UseCharacter("assets/characters/humanoid.yaml", "ball", &config);
   const Motion3D walk = ReadDeepMimicMotion(
       testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt"),
       character->shared_skeleton());
