@@ -180,15 +180,11 @@ void PrintBundleSummary(const ReferenceBundle& bundle,
   for (const ObjectTrack2D& object : bundle.views.front().clip.objects) {
     // The object's 3D, where the bundle holds it.
     std::string where_3d;
-    auto has = [&](const std::vector<ObjectTrack3D>& tracks) {
-      for (const ObjectTrack3D& track : tracks) {
-        if (track.name == object.name) return true;
-      }
-      return false;
-    };
-    if (bundle.ground_truth && has(bundle.ground_truth->objects))
+    if (bundle.ground_truth &&
+        FindObjectTrack(bundle.ground_truth->objects, object.name))
       where_3d = "ground truth";
-    if (bundle.estimate && has(bundle.estimate->front().objects))
+    if (bundle.estimate &&
+        FindObjectTrack(bundle.estimate->front().objects, object.name))
       where_3d += where_3d.empty() ? "estimate" : ", estimate";
     long seen = 0, total = 0;
     for (const ReferenceView& view : bundle.views) {

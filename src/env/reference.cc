@@ -91,15 +91,6 @@ void AddJointNoise(double sigma_rad, std::mt19937_64& rng,
                  simulation);
 }
 
-// The 3D track named `name` in `tracks`; null when there is none.
-const ObjectTrack3D* FindObject(const std::vector<ObjectTrack3D>& tracks,
-                                const std::string& name) {
-  for (const ObjectTrack3D& track : tracks) {
-    if (track.name == name) return &track;
-  }
-  return nullptr;
-}
-
 // The 3D tracks of the reference's objects (object point order) that a
 // buffer's starts take their objects from: the truth's, the view's
 // estimate's, or (default) the view's 2D put on the floor through its
@@ -114,10 +105,10 @@ std::vector<ObjectTrack3D> StartObjectTracks(const ReferenceBundle& bundle,
     const ObjectTrack3D* found = nullptr;
     switch (source) {
       case InitialStateSource::kTruth:
-        found = FindObject(bundle.ground_truth->objects, object.name);
+        found = FindObjectTrack(bundle.ground_truth->objects, object.name);
         break;
       case InitialStateSource::kEstimate:
-        found = FindObject((*bundle.estimate)[view].objects, object.name);
+        found = FindObjectTrack((*bundle.estimate)[view].objects, object.name);
         break;
       case InitialStateSource::kDefault: {
         RollingBall ball;
@@ -207,7 +198,7 @@ void SanitizeBundle(const Character& character, const TaskSources& sources,
                                          "replay them");
     }
     for (const ObjectTrack2D& object : bundle->views.front().clip.objects) {
-      if (FindObject(truth->objects, object.name) == nullptr) {
+      if (FindObjectTrack(truth->objects, object.name) == nullptr) {
         throw InputError(bundle->name,
                          "initial_states: truth needs the 3D of object '" +
                              object.name +
@@ -242,7 +233,7 @@ void SanitizeBundle(const Character& character, const TaskSources& sources,
                              "': fit it again for this character");
       }
       for (const ObjectTrack2D& object : bundle->views[v].clip.objects) {
-        if (FindObject(estimate.objects, object.name) == nullptr) {
+        if (FindObjectTrack(estimate.objects, object.name) == nullptr) {
           throw InputError(bundle->name,
                            "the estimate of view " + bundle->views[v].name +
                                " has no 3D of object '" + object.name +

@@ -127,13 +127,12 @@ FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
   double object_sum_m = 0.0;
   int num_objects = 0;
   for (const ObjectTrack3D& ours : estimate.objects) {
-    for (const ObjectTrack3D& theirs : truth.objects) {
-      if (theirs.name != ours.name) continue;
-      object_sum_m +=
-          YawAlignedObjectError(fitted, ours.positions_m, truth.keypoints_m,
-                                theirs.positions_m, *truth.layout, yaw_rad);
-      ++num_objects;
-    }
+    const ObjectTrack3D* theirs = FindObjectTrack(truth.objects, ours.name);
+    if (theirs == nullptr) continue;
+    object_sum_m +=
+        YawAlignedObjectError(fitted, ours.positions_m, truth.keypoints_m,
+                              theirs->positions_m, *truth.layout, yaw_rad);
+    ++num_objects;
   }
   if (num_objects > 0)
     accuracy.object_error_mm = 1000.0 * object_sum_m / num_objects;

@@ -248,10 +248,8 @@ void ValidateObjects(const std::vector<ObjectTrack3D>& objects,
       tracked = tracked || track.name == object.name;
     if (!tracked)
       throw InputError(source, what + " has no 2D track in the clips");
-    for (size_t k = 0; k < i; ++k) {
-      if (objects[k].name == object.name)
-        throw InputError(source, what + " appears twice");
-    }
+    if (FindObjectTrack(objects, object.name) != &object)
+      throw InputError(source, what + " appears twice");
     if (static_cast<int>(object.positions_m.size()) != num_frames) {
       throw InputError(source, what + " has " +
                                    std::to_string(object.positions_m.size()) +
@@ -284,6 +282,14 @@ void ProjectAsDetected(const PinholeCamera& camera,
 }
 
 }  // namespace
+
+const ObjectTrack3D* FindObjectTrack(const std::vector<ObjectTrack3D>& tracks,
+                                     const std::string& name) {
+  for (const ObjectTrack3D& track : tracks) {
+    if (track.name == name) return &track;
+  }
+  return nullptr;
+}
 
 void ValidateBundle(const ReferenceBundle& bundle, const std::string& source) {
   if (bundle.views.empty()) throw InputError(source, "bundle has no views");

@@ -37,6 +37,10 @@ struct ObjectTrack3D {
   std::vector<Eigen::Vector3d> positions_m;  // T, world
 };
 
+// The track named `name` in `tracks`; null when there is none.
+const ObjectTrack3D* FindObjectTrack(const std::vector<ObjectTrack3D>& tracks,
+                                     const std::string& name);
+
 // 3D truth behind a synthetic bundle, sampled at the bundle's frames.
 struct GroundTruth3D {
   const KeypointLayout* layout = &Coco17Layout();
