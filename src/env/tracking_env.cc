@@ -83,11 +83,18 @@ void TrackingEnv::SetReferenceNoise(const ReferenceNoise& noise) {
 
 void TrackingEnv::Reset(float* observation) {
   // Outline: pick a view (uniformly, or as hard-view sampling weighs them),
-  // a start frame uniformly (leaving at least one step), an initial state
-  // from that frame's buffer.
+  // a start frame (the first with first_frame_start_share, else uniformly,
+  // leaving at least one step), an initial state from that frame's buffer.
   const int view_index = initial_states_->DrawView(rng_);
   const TrackedView& view = reference_->views()[view_index];
-  int frame = std::uniform_int_distribution<int>(0, view.num_frames - 2)(rng_);
+  const bool start_at_first_frame =
+      options_.first_frame_start_share > 0.0 &&
+      std::uniform_real_distribution<double>(0.0, 1.0)(rng_) <
+          options_.first_frame_start_share;
+  int frame = 0;
+  if (!start_at_first_frame) {
+    frame = std::uniform_int_distribution<int>(0, view.num_frames - 2)(rng_);
+  }
   const StateBuffer& buffer = initial_states_->BufferOfView(view_index);
   ResetTo(view_index, frame, buffer.Draw(frame, rng_), observation);
 }

@@ -74,6 +74,12 @@ struct TrackingEnvOptions {
   // replays track the reference as given. 0 disables.
   double training_reference_noise_px = 0.0;
   double training_reference_drop = 0.0;
+  // The share of episodes (Reset) that start at their clip's first frame
+  // rather than at a uniformly drawn one. A rollout judged from the first
+  // frame (the tables' protocol), or a clip whose decisive moment comes
+  // early (a kick at frame 11 of 121), is otherwise practised by 1/T of the
+  // starts. 0: uniform, drawing nothing extra (runs stay bit-identical).
+  double first_frame_start_share = 0.0;
 
   // Every setting (common/settings.h); a training config's `env` section
   // (the simulation's fields spliced in, the reward as `env.reward`).
@@ -105,6 +111,10 @@ struct TrackingEnvOptions {
       Range{0, 1, /*min_open=*/false, /*max_open=*/true},
       "training episodes' 2D reference: the chance a keypoint is missed "
       "(confidence 0), drawn afresh per episode");
+    v("first_frame_start_share", self.first_frame_start_share,
+      Range::Closed(0, 1),
+      "share of training episodes that start at their clip's first frame "
+      "instead of a uniformly drawn one; 0: uniform");
     v.Nested("reward", self.reward);
     v("target", self.target, Range::Any(),
       "image_2d (the paper's 2D reprojection reward) or body_3d (the "

@@ -117,6 +117,42 @@ TEST(TrackingEnv, EpisodesAreTruncatedAtTheTimeLimitAndAtTheClipEnd) {
   EXPECT_EQ(steps, 3);
 }
 
+// first_frame_start_share sends that share of Resets to the clip's first
+// frame and draws the rest uniformly, as share 0 draws them all.
+TEST(TrackingEnv, AFirstFrameShareOfStartsBeginsAtTheClipsFirstFrame) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  const int num_start_frames = task.reference->views()[0].num_frames - 1;
+  const int num_resets = 2000;
+  std::vector<float> obs;
+  auto first_frame_share = [&](double share, int* distinct_frames) {
+    task.options.first_frame_start_share = share;
+    TrackingEnv env(task.character, task.reference, task.initial_states,
+                    task.options, 3);
+    obs.resize(env.observation_size());
+    std::vector<int> count(num_start_frames, 0);
+    for (int i = 0; i < num_resets; ++i) {
+      env.Reset(obs.data());
+      ++count.at(env.episode().start_frame);
+    }
+    *distinct_frames = static_cast<int>(
+        std::count_if(count.begin(), count.end(), [](int c) { return c > 0; }));
+    return static_cast<double>(count[0]) / num_resets;
+  };
+  int distinct = 0;
+  // Uniform: frame 0 about 1/60 of the starts, nearly every frame drawn.
+  EXPECT_LT(first_frame_share(0.0, &distinct), 0.05);
+  EXPECT_GT(distinct, num_start_frames * 9 / 10);
+  // Half: 0.5 + 0.5/60 expected; 2000 draws give a sigma of 0.011.
+  EXPECT_NEAR(first_frame_share(0.5, &distinct), 0.5 + 0.5 / num_start_frames,
+              0.05);
+  EXPECT_GT(distinct, num_start_frames * 9 / 10);
+  EXPECT_DOUBLE_EQ(first_frame_share(1.0, &distinct), 1.0);
+  EXPECT_EQ(distinct, 1);
+  task.options.first_frame_start_share = 1.5;
+  EXPECT_THROW(task.options.Validate(), ConfigError);
+}
+
 // Zero and random actions for 10 000 control steps each (4 envs): no NaN in
 // any observation or reward, no crash; episodes end and restart.
 TEST(VecEnv, ZeroAndRandomActionRolloutsStayFinite) {
