@@ -488,6 +488,8 @@ InitialStates::InitialStates(const TrackingReference& reference,
                    simulation);
       simulation.KeypointPositions(keypoints_xyz.data());
       ReadBodyTarget(simulation, keypoints_xyz.data(), &motion[t]);
+      for (const ObjectTrack3D& track : object_tracks)
+        motion[t].object_positions_m.push_back(track.positions_m[t]);
       if (joint_noise_rad > 0)
         AddJointNoise(joint_noise_rad, noise_rng, simulation);
       const SimState filled = simulation.Save();

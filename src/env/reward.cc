@@ -118,6 +118,12 @@ Tracking3DError MeasureTracking3D(const BodyTarget3D& simulated,
     sum_m += distance_m;
   }
   if (num_keypoints > 0) error.mean_keypoint_m = sum_m / num_keypoints;
+  error.num_objects = static_cast<int>(reference.object_positions_m.size());
+  for (int o = 0; o < error.num_objects; ++o) {
+    error.object_sq_m2 +=
+        (simulated.object_positions_m[o] - reference.object_positions_m[o])
+            .squaredNorm();
+  }
   return error;
 }
 
@@ -142,7 +148,10 @@ RewardTerms ComputeReward3D(const Tracking3DError& error, double abs_power_w,
       weights.keypoint_weight *
           std::exp(-weights.keypoint_scale * error.keypoint_local_sq_m2);
   terms.energy = -abs_power_w;
-  terms.total = terms.pose + energy_weight * terms.energy;
+  if (error.num_objects > 0)
+    terms.object = std::exp(-weights.object_scale * error.object_sq_m2);
+  terms.total = terms.pose + energy_weight * terms.energy +
+                weights.object_weight * terms.object;
   return terms;
 }
 

@@ -130,6 +130,9 @@ struct BodyTarget3D {
   std::vector<Eigen::Quaterniond> joint_rotations;
   std::vector<Eigen::Vector3d> joint_angular_velocities_rad_s;
   std::vector<Eigen::Vector3d> keypoints_m;
+  // The scene's tracked free objects (a ball), in object point order
+  // (world); empty without objects.
+  std::vector<Eigen::Vector3d> object_positions_m;
 };
 
 // How far a simulated state is from its 3D reference frame.
@@ -142,6 +145,8 @@ struct Tracking3DError {
   double keypoint_local_sq_m2 = 0.0;    // sum_k |(x_k - p) - (x^_k - p^)|^2
   double max_keypoint_m = 0.0;          // worst |x_k - x^_k| (world)
   double mean_keypoint_m = 0.0;         // mean |x_k - x^_k| (world)
+  int num_objects = 0;                  // objects compared (0: none)
+  double object_sq_m2 = 0.0;            // sum_o |b_o - b^_o|^2 (world)
 };
 
 // Compares two states of the same character (sizes must agree).
@@ -163,6 +168,10 @@ struct Body3DRewardWeights {
   double keypoint_scale = 10.0;         // 1/m^2
   double early_exit_max_error_m = 0.5;  // worst keypoint farther ends the
                                         // episode (0: never)
+  // The objects' term (a ball; 0: none), on the world positions: the
+  // two-stage baseline's ball, whose 3D it tracks as it tracks the body's.
+  double object_weight = 0.0;  // on exp(-object_scale * object_sq)
+  double object_scale = 5.0;   // 1/m^2 (the root's)
 
   template <typename Self, typename Visitor>
   static void VisitFields(Self& self, Visitor& v) {
@@ -190,12 +199,18 @@ struct Body3DRewardWeights {
     v("early_exit_max_error_m", self.early_exit_max_error_m, Range::AtLeast(0),
       "an episode ends when a keypoint is farther than this from its 3D "
       "reference (m; 0: never)");
+    v("object_weight", self.object_weight, Range::AtLeast(0),
+      "weight of exp(-object_scale * sum of squared world-position errors "
+      "of the tracked objects, a ball; 0: objects not rewarded)");
+    v("object_scale", self.object_scale, Range::AtLeast(0), "1/m^2");
   }
   void Validate() const;  // throws ConfigError
 };
 
-// r = sum of the weighted terms above + w_e r_e (the energy term of the 2D
-// reward, so that the tracking term is the only difference).
+// r = sum of the weighted body terms above (RewardTerms::pose) + w_e r_e
+// (the energy term of the 2D reward, so that the tracking term is the only
+// difference) + w_o exp(-object_scale object_sq) when objects are compared
+// (RewardTerms::object unweighted, as in the 2D reward).
 RewardTerms ComputeReward3D(const Tracking3DError& error, double abs_power_w,
                             const Body3DRewardWeights& weights,
                             double energy_weight);

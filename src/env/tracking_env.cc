@@ -32,8 +32,6 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
     // The 3D baselines follow the initial states' motion, alone.
     if (num_observed_views != 1)
       throw ConfigError("env: target body_3d observes one view");
-    if (reference_->num_object_points() > 0)
-      throw ConfigError("env: target body_3d does not track objects");
     if (reference_->sources().initial_states == InitialStateSource::kDefault) {
       throw ConfigError(
           "env: target body_3d needs a 3D reference: initial_states truth "
@@ -53,6 +51,7 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   const int num_keypoints = character->keypoint_layout().num_keypoints();
   keypoints_xyz_.resize(3 * num_keypoints);
   current_points_m_.resize(num_points);
+  future_points_m_.resize(num_points);
   projected_xy_.resize(2 * num_points * num_observed_views);
   in_front_.reset(new bool[num_points * num_observed_views]);
   projected_points_.resize(num_points * num_observed_views);
@@ -233,6 +232,8 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
         layout_.num_objects > 0 ? &object_error : nullptr, options_.reward);
   } else {
     ReadBodyTarget(simulation_, keypoints_xyz_.data(), &simulated_body_);
+    ReadObjectKinematics();
+    simulated_body_.object_positions_m = object_positions_;
     const Tracking3DError error_3d =
         MeasureTracking3D(simulated_body_, ReferenceBody(frame_));
     outcome.terms =
@@ -323,6 +324,13 @@ void TrackingEnv::ReadBodyKinematics() {
                                            velocity[2]};
     bodies_.linear_velocities_m_s[b] = {velocity[3], velocity[4], velocity[5]};
   }
+  ReadObjectKinematics();
+}
+
+void TrackingEnv::ReadObjectKinematics() {
+  const mjModel* model = simulation_.model();
+  const mjData* data = simulation_.data();
+  mjtNum velocity[6];  // angular, then linear (world frame)
   for (int o = 0; o < layout_.num_objects; ++o) {
     const int id = reference_->object_bodies()[o];
     object_positions_[o] = {data->xpos[3 * id], data->xpos[3 * id + 1],
@@ -342,23 +350,33 @@ void TrackingEnv::WriteObservation(float* observation) {
   if (layout_.critic_only_size > 0) WriteCriticOnlyBlock(observation);
   const int num_points = layout_.num_points;
   if (options_.target == TrackingTarget::kBody3D) {
-    // The 3D block: the character's keypoints, then L future reference
-    // frames' keypoints, relative to the character's root and heading.
+    // The 3D block: the character's keypoints and objects, then L future
+    // reference frames' keypoints and objects, relative to the character's
+    // root and heading.
     const Eigen::Vector3d& root = bodies_.positions_m[0];
     const Eigen::Quaterniond to_heading =
         InverseHeadingRotation(bodies_.orientations[0]);
     float* out = observation + layout_.view_offset();
     const int stride = num_points * ObservationLayout::kPointFeatures;
-    for (int j = 0; j < num_points; ++j) {
+    const int num_keypoints = num_points - layout_.num_objects;
+    for (int j = 0; j < num_keypoints; ++j) {
       current_points_m_[j] = {keypoints_xyz_[3 * j], keypoints_xyz_[3 * j + 1],
                               keypoints_xyz_[3 * j + 2]};
     }
+    std::copy(object_positions_.begin(), object_positions_.end(),
+              current_points_m_.begin() + num_keypoints);
     WriteRootRelativePoints(current_points_m_.data(), num_points, root,
                             to_heading, out);
     for (int l = 1; l <= layout_.num_future_frames; ++l) {
-      const int future = std::min(frame_ + l, view_->num_frames - 1);
-      WriteRootRelativePoints(ReferenceBody(future).keypoints_m.data(),
-                              num_points, root, to_heading, out + l * stride);
+      const BodyTarget3D& future =
+          ReferenceBody(std::min(frame_ + l, view_->num_frames - 1));
+      std::copy(future.keypoints_m.begin(), future.keypoints_m.end(),
+                future_points_m_.begin());
+      std::copy(future.object_positions_m.begin(),
+                future.object_positions_m.end(),
+                future_points_m_.begin() + num_keypoints);
+      WriteRootRelativePoints(future_points_m_.data(), num_points, root,
+                              to_heading, out + l * stride);
     }
     return;
   }

@@ -231,7 +231,8 @@ class TrackingEnv {
   // `last_frame` (drawn the first time an episode reaches them).
   void CorruptReferenceUpTo(int last_frame);
   void ProjectCurrentPoints();
-  void ReadBodyKinematics();
+  void ReadBodyKinematics();  // and the objects' (ReadObjectKinematics)
+  void ReadObjectKinematics();
   // With critic_observes_3d: the critic-only block of the current frame.
   void WriteCriticOnlyBlock(float* observation) const;
   // The episode's 3D reference (the initial states' motion) at `frame`,
@@ -273,6 +274,7 @@ class TrackingEnv {
   std::vector<Eigen::Vector3d> object_positions_, object_velocities_;
   BodyTarget3D simulated_body_;                    // target body_3d
   std::vector<Eigen::Vector3d> current_points_m_;  // target body_3d
+  std::vector<Eigen::Vector3d> future_points_m_;   // target body_3d
 };
 
 }  // namespace m2d

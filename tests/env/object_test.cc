@@ -2,6 +2,8 @@
 // and the starts that place it.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "common/error.h"
 #include "env/tracking_env.h"
 #include "env_fixture.h"
@@ -160,6 +162,62 @@ TEST(TrackingEnvWithObject, StartsPlaceTheBallFromEachSource) {
     seen_rolling += t > 9;
   }
   EXPECT_GT(seen_rolling, 3);
+}
+
+// The two-stage baseline with a ball (target body_3d): the initial states'
+// motion carries the ball's 3D, the 3D block observes it after the body's
+// keypoints, and the reward's object term scores its world position.
+TEST(TrackingEnvWithObject, TheThreeDTargetObservesAndRewardsTheBall) {
+  TrackingEnvOptions options;
+  options.target = TrackingTarget::kBody3D;
+  options.reward_3d.object_weight = 0.5;
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      options.simulation);
+  const FreeObject& ball = character->free_objects()[0];
+  const ReferenceBundle bundle = GlidingWithRollingBall(*character);
+  const std::vector<Eigen::Vector3d>& truth =
+      bundle.ground_truth->objects[0].positions_m;
+  TaskSources sources;  // the truth's starts and cameras
+  auto reference = TrackingReference::Prepare(
+      {bundle}, *character, options.simulation.control_hz, sources);
+  auto states = std::make_shared<InitialStates>(
+      *reference, character, options.simulation, StateBufferOptions());
+  for (int t : {0, 20, 30}) {
+    ASSERT_EQ(states->motion(0)[t].object_positions_m.size(), 1u);
+    EXPECT_LT((states->motion(0)[t].object_positions_m[0] - truth[t]).norm(),
+              1e-12);
+  }
+  TrackingEnv env(character, reference, states, options, 5);
+  std::vector<float> obs(env.observation_size()),
+      action(env.action_size(), 0.0f);
+
+  // Rolling at 3 m/s from frame 20: the ball is the block's 18th point, now
+  // and in the next reference frame, at its distance from the root.
+  const int frame = 20;
+  env.ResetTo(0, frame, states->buffer(0).entry(frame, 0).state, obs.data());
+  const Eigen::Vector3d root(env.simulation().data()->qpos);
+  const int stride = 18 * ObservationLayout::kPointFeatures;
+  const float* now = obs.data() + env.layout().view_offset() + 17 * 3;
+  const float* next = now + stride;
+  EXPECT_NEAR(Eigen::Vector3d(now[0], now[1], now[2]).norm(),
+              (truth[frame] - root).norm(), 1e-4);
+  EXPECT_NEAR(Eigen::Vector3d(next[0], next[1], next[2]).norm(),
+              (truth[frame + 1] - root).norm(), 1e-4);
+  StepOutcome outcome = env.Step(action.data(), obs.data());
+  EXPECT_GT(outcome.terms.object, 0.95);  // it rolls on as its reference
+  EXPECT_NEAR(outcome.terms.total,
+              outcome.terms.pose + 0.5 * outcome.terms.object +
+                  options.reward.energy_weight * outcome.terms.energy,
+              1e-9);
+
+  // The same start with the ball 0.3 m behind: exp(-5 * 0.09) = 0.64.
+  SimState behind = states->buffer(0).entry(frame, 0).state;
+  behind.qpos[ball.qpos_address] -= 0.3;
+  env.ResetTo(0, frame, behind, obs.data());
+  outcome = env.Step(action.data(), obs.data());
+  EXPECT_NEAR(outcome.terms.object, std::exp(-0.45), 0.05);
+  EXPECT_FALSE(outcome.terminated);  // the exit watches the body only
 }
 
 TEST(TrackingEnvWithObject, StartsWithoutTheBallsThreeDAreNamedErrors) {

@@ -191,6 +191,36 @@ TEST(Tracking3D, EachErrorLowersItsTermAsDeepMimicsExponentials) {
               1.0 - 0.02, 1e-12);
 }
 
+// The two-stage baseline's ball: a world-position term, weighted as
+// configured, and nothing (whatever the weight) when no object is compared.
+TEST(Tracking3D, TheObjectTermRewardsTheBallsWorldPosition) {
+  BodyTarget3D reference = TwoJointBody();
+  Body3DRewardWeights weights;
+  weights.object_weight = 0.5;
+  // No objects: the body's terms alone, the weight notwithstanding.
+  Tracking3DError error = MeasureTracking3D(reference, reference);
+  EXPECT_EQ(error.num_objects, 0);
+  EXPECT_NEAR(ComputeReward3D(error, 0.0, weights, 0.0).total, 1.0, 1e-12);
+  // A ball 0.3 m off (and the body on its reference): 0.5 exp(-5 * 0.09).
+  reference.object_positions_m = {{2.0, 1.0, 0.11}};
+  BodyTarget3D behind = reference;
+  behind.object_positions_m[0] += Eigen::Vector3d(-0.3, 0.0, 0.0);
+  error = MeasureTracking3D(behind, reference);
+  EXPECT_EQ(error.num_objects, 1);
+  EXPECT_NEAR(error.object_sq_m2, 0.09, 1e-12);
+  EXPECT_DOUBLE_EQ(error.max_keypoint_m, 0.0);  // the exit watches the body
+  RewardTerms terms = ComputeReward3D(error, 0.0, weights, 0.0);
+  EXPECT_NEAR(terms.object, std::exp(-0.45), 1e-12);
+  EXPECT_NEAR(terms.total, 1.0 + 0.5 * std::exp(-0.45), 1e-12);
+  // On its reference: the whole weight.
+  EXPECT_NEAR(ComputeReward3D(MeasureTracking3D(reference, reference), 0.0,
+                              weights, 0.0)
+                  .total,
+              1.5, 1e-12);
+  weights.object_scale = -1.0;
+  EXPECT_THROW(weights.Validate(), ConfigError);
+}
+
 TEST(Tracking3D, BadWeightsAreRejected) {
   Body3DRewardWeights weights;
   weights.pose_scale = -1;

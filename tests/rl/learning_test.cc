@@ -328,15 +328,14 @@ TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
 constexpr int64_t kBallTrainingSamples = 200'000;
 constexpr double kMinBallSurvivalGain = 1.3;  // measured 1.72x
 
-TEST(Learning, PpoLearnsToWalkAndKickTheBallFromAStrippedAndFittedBundle) {
-  std::string dir = testing::TempDir("learning_ball");
-  TrainConfig config;
-  config.env.reward.object_weight = 0.5;
-  auto character =
-      UseCharacter("assets/characters/humanoid.yaml", "ball", &config);
+// What a user of the ball has: 2 s of the walk with a ball kicked along,
+// seen by 2 static views as 2D (the walker's keypoints and the ball's
+// centre), fitted: the person, and the ball on the floor under the fitted
+// cameras.
+ReferenceBundle FittedWalkWithBall(const Character& character) {
   const Motion3D walk = ReadDeepMimicMotion(
       testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt"),
-      character->shared_skeleton());
+      character.shared_skeleton());
   BundleFromMotionOptions bundle_options;
   bundle_options.duration_s = 2.0;
   bundle_options.rig.num_views = 2;
@@ -344,20 +343,53 @@ TEST(Learning, PpoLearnsToWalkAndKickTheBallFromAStrippedAndFittedBundle) {
   bundle_options.aim = RigAim::kPathMiddle;
   const Motion3D sampled = SampleMotionForBundle(walk, bundle_options);
   const BallPlacement placement = PlaceBallInFootPath(
-      *character, sampled, character->free_objects()[0].radius_m);
+      character, sampled, character.free_objects()[0].radius_m);
   const ReferenceBundle stripped = StripBundle(MakeBundleFromMotion(
-      walk, character->keypoint_map(), bundle_options, "walk_ball",
-      ReplayObjectsAlongMotion(*character, sampled, {placement.center_m})));
-  ASSERT_EQ(stripped.views[0].clip.objects.size(), 1u);
+      walk, character.keypoint_map(), bundle_options, "walk_ball",
+      ReplayObjectsAlongMotion(character, sampled, {placement.center_m})));
+  EXPECT_EQ(stripped.views[0].clip.objects.size(), 1u);
   FitOptions fit;
   fit.fixed_focal_px = 1000.0;
   fit.num_threads = 2;
-  ReferenceBundle fitted = FitBundle(stripped, *character, fit, "walk_ball");
-  const auto [before, after] = TrainAndEvaluateFrom2d(
-      "walk and kick from 2D only", "walk_ball_fitted", fitted, character, dir,
-      config, kBallTrainingSamples);
+  return FitBundle(stripped, character, fit, "walk_ball");
+}
+
+TEST(Learning, PpoLearnsToWalkAndKickTheBallFromAStrippedAndFittedBundle) {
+  std::string dir = testing::TempDir("learning_ball");
+  TrainConfig config;
+  config.env.reward.object_weight = 0.5;
+  auto character =
+      UseCharacter("assets/characters/humanoid.yaml", "ball", &config);
+  const auto [before, after] =
+      TrainAndEvaluateFrom2d("walk and kick from 2D only", "walk_ball_fitted",
+                             FittedWalkWithBall(*character), character, dir,
+                             config, kBallTrainingSamples);
   std::printf("EO2D %.1f -> %.1f px\n", before.eo2d_px, after.eo2d_px);
   EXPECT_GT(after.mean_frames, before.mean_frames * kMinBallSurvivalGain);
+}
+
+// The two-stage baseline with the ball (configs/ball_sfv.yaml): the same
+// fitted bundle, imitated as 3D (target body_3d: the fit's person and its
+// ball, a term on the ball's world position), judged by the same 2D
+// evaluation. Calibrated 2026-11-30 (seed 7, 200k samples beside a
+// training; 89 s): frames before the 100 px exit 15.2 -> 25.3, E2D 29.6 ->
+// 31.8 px and EO2D 43 -> 78 px over those longer rollouts (as the 2D
+// tracker's above), so only the survival is asserted.
+constexpr double kMinBallSfvSurvivalGain = 1.3;  // measured 1.66x
+
+TEST(Learning, TheTwoStageBaselineLearnsToWalkWithTheBallFromTheFitsThreeD) {
+  std::string dir = testing::TempDir("learning_ball_sfv");
+  TrainConfig config;
+  config.env.target = TrackingTarget::kBody3D;
+  config.env.early_exit = false;  // the 3D exit ends its episodes
+  config.env.reward_3d.object_weight = 0.5;
+  auto character =
+      UseCharacter("assets/characters/humanoid.yaml", "ball", &config);
+  const auto [before, after] = TrainAndEvaluateFrom2d(
+      "Sfv* with the ball", "walk_ball_fitted", FittedWalkWithBall(*character),
+      character, dir, config, kBallTrainingSamples);
+  std::printf("EO2D %.1f -> %.1f px\n", before.eo2d_px, after.eo2d_px);
+  EXPECT_GT(after.mean_frames, before.mean_frames * kMinBallSfvSurvivalGain);
 }
 
 }  // namespace
