@@ -26,12 +26,16 @@ class TableRowTest : public ::testing::Test {
   // Sources the script (as the bench tables do, under `set -euo
   // pipefail`) and runs `call`, written to a file so that names with
   // spaces need no second level of quoting.
-  CommandResult Run(const std::string& call) const {
+  // `settings` (shell assignments) come after the source, before the
+  // header.
+  CommandResult Run(const std::string& call,
+                    const std::string& settings = "") const {
     const std::string driver = dir_ + "/driver.sh";
     std::ofstream(driver) << "set -euo pipefail\n"
                           << "TABLE_BIN=" << MIMIC2D_BINARY << "\n"
                           << "source "
                           << testing::SourcePath("bench/table_row.sh") << "\n"
+                          << settings << "\n"
                           << "table_header\n"
                           << call << "\n";
     return RunCommand("bash " + driver);
@@ -61,6 +65,38 @@ TEST_F(TableRowTest, ARowIsTheEvalsAllLine) {
   EXPECT_TRUE(std::regex_search(result.output, row)) << result.output;
   EXPECT_TRUE(fs::exists(dir_ + "/walk_row.json"));
   EXPECT_TRUE(fs::exists(dir_ + "/walk_row.txt"));
+}
+
+// TABLE_OBJECTS=1 (bench/ball_table.sh) adds the ball's EO2D after E2D, in
+// the header, the rows and a missing checkpoint's empty cells alike.
+TEST_F(TableRowTest, WithObjectsTheTableCarriesEO2D) {
+  M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
+  const std::string bundle = dir_ + "/walk.json";
+  ASSERT_EQ(RunMimic2d("clip from-motion " + walk +
+                       " --views 1 --duration 1 -o " + bundle)
+                .exit_code,
+            0);
+  const std::string policy =
+      testing::SourcePath("assets/policies/walk/checkpoint.pt");
+  CommandResult result = Run(
+      "table_row walk walk clean " + policy + " " + dir_ +
+          "/walk_row --bundle " + bundle +
+          " --episodes 1 --episode-s 1 --starts truth --cameras truth\n" +
+          "table_row ours walk clean " + dir_ + "/none.pt " + dir_ + "/none",
+      "TABLE_OBJECTS=1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("| E2D (px) | EO2D (px) | E3D (mm) |"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("|---|---|---|---|---|---|---|---|---|---|\n"),
+            std::string::npos)
+      << result.output;
+  // This walk has no ball: its EO2D cell is the eval's "-".
+  const std::regex row(
+      R"(\| walk \| walk \| clean \| [0-9.]+ \| [0-9.]+ \| - \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \|)");
+  EXPECT_TRUE(std::regex_search(result.output, row)) << result.output;
+  EXPECT_NE(result.output.find("/none.pt) | | | | | | |"), std::string::npos)
+      << result.output;
 }
 
 TEST_F(TableRowTest, AMissingCheckpointsRowSaysSoAndTheTableGoesOn) {
