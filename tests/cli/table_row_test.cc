@@ -41,22 +41,28 @@ class TableRowTest : public ::testing::Test {
     return RunCommand("bash " + driver);
   }
 
+  // 1 s of `walk` (a DeepMimic clip) seen by one camera, and the table_row
+  // call that evaluates the walk policy on it from the truth's starts and
+  // cameras, as the row `name`.
+  std::string WalkRowCall(const std::string& walk,
+                          const std::string& name) const {
+    const std::string bundle = dir_ + "/walk.json";
+    EXPECT_EQ(RunMimic2d("clip from-motion " + walk +
+                         " --views 1 --duration 1 -o " + bundle)
+                  .exit_code,
+              0);
+    return "table_row " + name + " walk clean " +
+           testing::SourcePath("assets/policies/walk/checkpoint.pt") + " " +
+           dir_ + "/walk_row --bundle " + bundle +
+           " --episodes 1 --episode-s 1 --starts truth --cameras truth";
+  }
+
   std::string dir_;
 };
 
 TEST_F(TableRowTest, ARowIsTheEvalsAllLine) {
   M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
-  const std::string bundle = dir_ + "/walk.json";
-  ASSERT_EQ(RunMimic2d("clip from-motion " + walk +
-                       " --views 1 --duration 1 -o " + bundle)
-                .exit_code,
-            0);
-  const std::string policy =
-      testing::SourcePath("assets/policies/walk/checkpoint.pt");
-  CommandResult result =
-      Run("table_row 'the walk (truth starts)' walk clean " + policy + " " +
-          dir_ + "/walk_row --bundle " + bundle +
-          " --episodes 1 --episode-s 1 --starts truth --cameras truth");
+  CommandResult result = Run(WalkRowCall(walk, "'the walk (truth starts)'"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   // Succ, E2D, E3D, root-relative, PA and Jitter: all measured (the truth
   // starts and cameras share the truth's world, so global E3D exists).
@@ -71,19 +77,10 @@ TEST_F(TableRowTest, ARowIsTheEvalsAllLine) {
 // the header, the rows and a missing checkpoint's empty cells alike.
 TEST_F(TableRowTest, WithObjectsTheTableCarriesEO2D) {
   M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
-  const std::string bundle = dir_ + "/walk.json";
-  ASSERT_EQ(RunMimic2d("clip from-motion " + walk +
-                       " --views 1 --duration 1 -o " + bundle)
-                .exit_code,
-            0);
-  const std::string policy =
-      testing::SourcePath("assets/policies/walk/checkpoint.pt");
-  CommandResult result = Run(
-      "table_row walk walk clean " + policy + " " + dir_ +
-          "/walk_row --bundle " + bundle +
-          " --episodes 1 --episode-s 1 --starts truth --cameras truth\n" +
-          "table_row ours walk clean " + dir_ + "/none.pt " + dir_ + "/none",
-      "TABLE_OBJECTS=1");
+  CommandResult result =
+      Run(WalkRowCall(walk, "walk") + "\ntable_row ours walk clean " + dir_ +
+              "/none.pt " + dir_ + "/none",
+          "TABLE_OBJECTS=1");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("| E2D (px) | EO2D (px) | E3D (mm) |"),
             std::string::npos)
