@@ -38,6 +38,19 @@ int RunEval(const EvalArgs& args) {
       options.success_measure == FrameErrorMeasure::kWorst ? "worst keypoint's"
                                                            : "mean keypoint",
       options.success_threshold_px);
+  if (options.push_force_n > 0) {
+    std::printf(
+        "pushes: %g N on the root, horizontal, every %g s for %g s "
+        "(directions from seed %llu)\n",
+        options.push_force_n, options.push_every_s, options.push_duration_s,
+        static_cast<unsigned long long>(options.perturbation_seed));
+  }
+  if (options.object_start_square_m > 0) {
+    std::printf(
+        "objects start moved uniformly within a %g m square (seed %llu)\n",
+        options.object_start_square_m,
+        static_cast<unsigned long long>(options.perturbation_seed));
+  }
   PrintEvalTable(evaluation);
   if (!args.output.empty()) {
     WriteEvalJson(args.output, args.checkpoint, options, evaluation);
@@ -98,6 +111,25 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
                  "Start episodes from the checkpoint's ASI buffers (the "
                  "starts as training refined them) instead of fresh ones; "
                  "needs the training's sources and bundles");
+  eval->add_option("--push", args->options.push_force_n,
+                   "Robustness: a horizontal push of this force on the root "
+                   "(N; the paper: 300), every --push-every-s for "
+                   "--push-duration-s, in a direction drawn per push; 0: none")
+      ->capture_default_str();
+  eval->add_option("--push-every-s", args->options.push_every_s,
+                   "Period of the pushes (s)")
+      ->capture_default_str();
+  eval->add_option("--push-duration-s", args->options.push_duration_s,
+                   "Length of each push (s)")
+      ->capture_default_str();
+  eval->add_option("--object-start-square", args->options.object_start_square_m,
+                   "Robustness: move each tracked object's start (the ball) "
+                   "by an offset drawn uniformly in a square of this side on "
+                   "the floor (m; the paper: 1); 0: none")
+      ->capture_default_str();
+  eval->add_option("--perturbation-seed", args->options.perturbation_seed,
+                   "Seed of the push directions and object offsets")
+      ->capture_default_str();
   eval->add_option("-o,--output", args->output, "Write the table as JSON here");
   eval->callback([run, args] { *run = [args] { return RunEval(*args); }; });
 }

@@ -186,6 +186,11 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
       {"success_threshold_px", options.success_threshold_px},
       {"success_measure", SettingName(options.success_measure)},
       {"views_at_once", options.num_views},
+      {"push_force_n", options.push_force_n},
+      {"push_every_s", options.push_every_s},
+      {"push_duration_s", options.push_duration_s},
+      {"object_start_square_m", options.object_start_square_m},
+      {"perturbation_seed", options.perturbation_seed},
       {"rows", nlohmann::json::array()},
       {"all", RowToJson(AggregateRows(rows))}};
   for (const EvalRow& row : rows) json["rows"].push_back(RowToJson(row));

@@ -101,6 +101,27 @@ inline WalkTask MakeWalkTask(const std::string& motion_path,
   return task;
 }
 
+// Gives `bundle` the ball of `character`'s scene resting where the scene
+// puts it: its 2D in every view (where it projects) and its 3D in the
+// truth. Returns that position (m).
+inline Eigen::Vector3d AddRestingBall(const Character& character,
+                                      ReferenceBundle* bundle) {
+  const FreeObject& ball = character.free_objects().at(0);
+  const double* qpos0 = character.model()->qpos0 + ball.qpos_address;
+  const Eigen::Vector3d ball_m(qpos0[0], qpos0[1], qpos0[2]);
+  for (ReferenceView& view : bundle->views) {
+    ObjectTrack2D track{ball.name, {}};
+    for (int t = 0; t < view.clip.num_frames(); ++t) {
+      Projection p = view.CameraAt(t).Project(ball_m);
+      track.points.push_back({p.pixel_px.x(), p.pixel_px.y(), 1.0});
+    }
+    view.clip.objects.push_back(track);
+  }
+  bundle->ground_truth->objects = {
+      {ball.name, std::vector<Eigen::Vector3d>(bundle->num_frames(), ball_m)}};
+  return ball_m;
+}
+
 }  // namespace m2d::testing
 
 #endif  // MIMIC2D_TESTS_ENV_ENV_FIXTURE_H_

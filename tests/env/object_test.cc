@@ -21,22 +21,8 @@ TEST(TrackingEnvWithObject, ObservesTheBallAndRewardsItsTracking) {
   ASSERT_EQ(character->free_objects().size(), 1u);
   ReferenceBundle bundle = testing::MakeWalkBundle(path, *character, 2.0);
 
-  // The ball's 2D track: where the scene's resting ball projects.
-  Simulation probe(character, options.simulation);
-  const int ball_body = character->free_objects()[0].body_id;
-  const double* ball = probe.data()->xpos + 3 * ball_body;
-  Eigen::Vector3d ball_m(ball[0], ball[1], ball[2]);
-  for (ReferenceView& view : bundle.views) {
-    ObjectTrack2D track{"ball", {}};
-    for (int t = 0; t < view.clip.num_frames(); ++t) {
-      Projection p = view.CameraAt(t).Project(ball_m);
-      track.points.push_back({p.pixel_px.x(), p.pixel_px.y(), 1.0});
-    }
-    view.clip.objects.push_back(track);
-  }
-  // Its 3D, which the truth's starts place it from.
-  bundle.ground_truth->objects = {
-      {"ball", std::vector<Eigen::Vector3d>(bundle.num_frames(), ball_m)}};
+  // The ball resting where the scene puts it, in the 2D and the truth.
+  const Eigen::Vector3d ball_m = testing::AddRestingBall(*character, &bundle);
   auto reference = TrackingReference::Prepare({bundle}, *character,
                                               options.simulation.control_hz);
   EXPECT_EQ(reference->num_object_points(), 1);

@@ -263,6 +263,116 @@ TEST(EvaluatePolicy, InvalidOptionsAreRejected) {
                ConfigError);
 }
 
+// Pushes start every push_every_s into a rollout (not at its start) and
+// last push_duration_s, whole control steps at the control rate.
+TEST(EvaluatePolicy, PushesFollowTheirScheduleInControlSteps) {
+  EvalOptions options;
+  EXPECT_EQ(PushAtStep(60, 30.0, options), 0);  // no force: no push
+  options.push_force_n = 300.0;                 // every 2 s for 0.2 s
+  EXPECT_EQ(PushAtStep(0, 30.0, options), 0);
+  EXPECT_EQ(PushAtStep(59, 30.0, options), 0);
+  for (int step = 60; step < 66; ++step)
+    EXPECT_EQ(PushAtStep(step, 30.0, options), 1) << step;
+  EXPECT_EQ(PushAtStep(66, 30.0, options), 0);
+  EXPECT_EQ(PushAtStep(119, 30.0, options), 0);
+  EXPECT_EQ(PushAtStep(120, 30.0, options), 2);
+  options.push_duration_s = options.push_every_s;  // one push after another
+  EXPECT_EQ(PushAtStep(119, 30.0, options), 1);
+  EXPECT_EQ(PushAtStep(120, 30.0, options), 2);
+  options.push_duration_s = 3.0;  // longer than the period
+  EXPECT_THROW(options.Validate(), ConfigError);
+  options.push_duration_s = 0.2;
+  options.push_force_n = -1.0;
+  EXPECT_THROW(options.Validate(), ConfigError);
+  options.push_force_n = 0.0;
+  options.object_start_square_m = std::nan("");
+  EXPECT_THROW(options.Validate(), ConfigError);
+}
+
+// A policy that ignores what it sees rolls the same motion out in every
+// view (AGenerousThreshold... above); pushed, each rollout goes its own way
+// (a direction drawn per push and rollout), farther from the truth, and the
+// same seed repeats the evaluation exactly.
+TEST(EvaluatePolicy, PushesMoveTheCharacterAndRepeatForASeed) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  EvalOptions options;
+  options.episodes_per_view = 1;
+  options.episode_s = 1.5;
+  options.success_threshold_px = 1e6;  // every rollout runs its length
+  auto evaluate = [&](const EvalOptions& eval_options) {
+    return EvaluatePolicy(policy, task.character, task.reference,
+                          task.initial_states, task.options, eval_options,
+                          {task.reference->bundles()[0].ground_truth});
+  };
+  const std::vector<EvalRow> still = evaluate(options);
+  options.push_force_n = 1000.0;
+  options.push_every_s = 0.5;
+  const std::vector<EvalRow> pushed = evaluate(options);
+  const std::vector<EvalRow> again = evaluate(options);
+  ASSERT_EQ(pushed.size(), 4u);
+  double e3d_still = 0, e3d_pushed = 0;
+  for (size_t r = 0; r < pushed.size(); ++r) {
+    EXPECT_DOUBLE_EQ(still[r].e3d_mm, still[0].e3d_mm);
+    EXPECT_DOUBLE_EQ(again[r].e3d_mm, pushed[r].e3d_mm);
+    EXPECT_DOUBLE_EQ(again[r].jitter, pushed[r].jitter);
+    if (r > 0) {
+      EXPECT_NE(pushed[r].e3d_mm, pushed[0].e3d_mm);
+    }
+    e3d_still += still[r].e3d_mm;
+    e3d_pushed += pushed[r].e3d_mm;
+  }
+  EXPECT_GT(e3d_pushed, 1.2 * e3d_still);
+  options.perturbation_seed = 2;
+  EXPECT_NE(evaluate(options)[0].e3d_mm, pushed[0].e3d_mm);
+}
+
+// The ball's start moved within a 1 m square (the paper's "w/ Rnd."): the
+// resting ball no longer sits where its 2D shows it, so EO2D rises from
+// nearly 0; bundles without an object refuse the option.
+TEST(EvaluatePolicy, ObjectStartsMoveWithinTheirSquare) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  SimulationOptions simulation;
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      simulation);
+  ReferenceBundle bundle = testing::MakeWalkBundle(path, *character, 1.0);
+  testing::AddRestingBall(*character, &bundle);
+  TrackingTask task =
+      BuildTrackingTask(character, {bundle}, TrackingTaskOptions());
+  TrackingEnvOptions env_options;
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  env_options, 0);
+  ZeroPolicy policy(env.observation_size(), env.action_size());
+  EvalOptions options;
+  options.episodes_per_view = 1;
+  options.episode_s = 0.3;
+  options.success_threshold_px = 1e6;
+  auto eo2d = [&](double square_m) {
+    options.object_start_square_m = square_m;
+    return AggregateRows(EvaluatePolicy(policy, task.character, task.reference,
+                                        task.initial_states, env_options,
+                                        options))
+        .eo2d_px;
+  };
+  const double in_place = eo2d(0.0);
+  EXPECT_LT(in_place, 1.0);
+  EXPECT_GT(eo2d(1.0), in_place + 5.0);
+
+  M2D_REQUIRE_SHARED(walk, kWalk);
+  testing::WalkTask no_ball = testing::MakeWalkTask(walk, 1.0);
+  ZeroPolicy walker = MakeZeroPolicy(no_ball);
+  try {
+    EvaluatePolicy(walker, no_ball.character, no_ball.reference,
+                   no_ball.initial_states, no_ball.options, options);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(error.problem().find("track an object"), std::string::npos)
+        << error.what();
+  }
+}
+
 // Zero-shot multi-view: K = 3 rolls each of the walk's 4 views out with the
 // two next ones, named together; with a policy that ignores what it sees,
 // the 3D outcome equals the one-view evaluation's from the same starts. A
