@@ -16,7 +16,7 @@ bench_fit_s=${BENCH_FIT_S:-30}
 limit_s=${LIMIT_S:-900}
 sandbox=$(mktemp -d)
 trap 'rm -rf "$sandbox"' EXIT
-for linked in build assets configs; do ln -s "$repo/$linked" "$sandbox/$linked"; done
+for linked in build assets configs bench; do ln -s "$repo/$linked" "$sandbox/$linked"; done
 
 # The README's command lines, continuation lines joined, comments dropped.
 mapfile -t commands < <(awk '
