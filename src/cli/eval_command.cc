@@ -38,11 +38,12 @@ int RunEval(const EvalArgs& args) {
       options.success_measure == FrameErrorMeasure::kWorst ? "worst keypoint's"
                                                            : "mean keypoint",
       options.success_threshold_px);
-  if (options.push_force_n > 0) {
+  if (options.pushes.force_n > 0) {
     std::printf(
         "pushes: %g N on the root, horizontal, every %g s for %g s "
         "(directions from seed %llu)\n",
-        options.push_force_n, options.push_every_s, options.push_duration_s,
+        options.pushes.force_n, options.pushes.every_s,
+        options.pushes.duration_s,
         static_cast<unsigned long long>(options.perturbation_seed));
   }
   if (options.object_start_square_m > 0) {
@@ -111,15 +112,15 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
                  "Start episodes from the checkpoint's ASI buffers (the "
                  "starts as training refined them) instead of fresh ones; "
                  "needs the training's sources and bundles");
-  eval->add_option("--push", args->options.push_force_n,
+  eval->add_option("--push", args->options.pushes.force_n,
                    "Robustness: a horizontal push of this force on the root "
                    "(N; the paper: 300), every --push-every-s for "
                    "--push-duration-s, in a direction drawn per push; 0: none")
       ->capture_default_str();
-  eval->add_option("--push-every-s", args->options.push_every_s,
+  eval->add_option("--push-every-s", args->options.pushes.every_s,
                    "Period of the pushes (s)")
       ->capture_default_str();
-  eval->add_option("--push-duration-s", args->options.push_duration_s,
+  eval->add_option("--push-duration-s", args->options.pushes.duration_s,
                    "Length of each push (s)")
       ->capture_default_str();
   eval->add_option("--object-start-square", args->options.object_start_square_m,

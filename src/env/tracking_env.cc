@@ -1,12 +1,37 @@
 #include "env/tracking_env.h"
 
 #include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
 
 #include "common/error.h"
 
 namespace m2d {
 
-void TrackingEnvOptions::Validate() const { CheckRanges(*this, "env"); }
+void PushOptions::Validate() const {
+  CheckRanges(*this, "pushes");
+  if (duration_s > every_s) {
+    throw ConfigError("pushes: duration_s (" + std::to_string(duration_s) +
+                      " s) must be at most every_s (" +
+                      std::to_string(every_s) + " s)");
+  }
+}
+
+int PushAtStep(int step, double control_hz, const PushOptions& pushes) {
+  if (pushes.force_n <= 0) return 0;
+  // A step is placed at its middle, so that 2 s at 30 Hz is step 60
+  // whatever the rounding.
+  const double time_s = (step + 0.5) / control_hz;
+  const int k = static_cast<int>(std::floor(time_s / pushes.every_s));
+  if (k < 1) return 0;
+  return time_s - k * pushes.every_s < pushes.duration_s ? k : 0;
+}
+
+void TrackingEnvOptions::Validate() const {
+  CheckRanges(*this, "env");
+  pushes.Validate();
+}
 
 TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
                          std::shared_ptr<const TrackingReference> reference,
@@ -147,6 +172,10 @@ void TrackingEnv::BeginEpisode(int frame) {
   episode_ = EpisodeStats();
   episode_.view_index = view_index;
   episode_.start_frame = frame;
+  // A state captured mid-push (ASI) carries its force: no episode starts
+  // pushed.
+  push_ = 0;
+  if (options_.pushes.force_n > 0) SetRootPush(0.0, 0.0);
   episode_corrupted_ = reference_noise_.enabled();
   if (episode_corrupted_) {
     // The episode observes corrupted copies of its views, drawn from here
@@ -192,6 +221,17 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
   // Outline: physics, advance the reference, measure the reprojection,
   // reward, decide whether the episode ends, observe.
   StepOutcome outcome;
+  if (options_.pushes.force_n > 0) {
+    const int push = PushAtStep(episode_.steps, options_.simulation.control_hz,
+                                options_.pushes);
+    if (push != push_) {
+      push_ = push;
+      SetRootPush(
+          push > 0 ? options_.pushes.force_n : 0.0,
+          push > 0 ? std::uniform_real_distribution<double>(0, 2 * M_PI)(rng_)
+                   : 0.0);
+    }
+  }
   StepResult physics = simulation_.Step(action);
   ++frame_;
   ++episode_.steps;
@@ -305,6 +345,14 @@ const BodyTarget3D& TrackingEnv::ReferenceBody(int frame) const {
   const std::vector<BodyTarget3D>& motion =
       initial_states_->motion(initial_states_->BufferOf(episode_.view_index));
   return motion[std::min(frame, static_cast<int>(motion.size()) - 1)];
+}
+
+void TrackingEnv::SetRootPush(double force_n, double heading_rad) {
+  const int root = simulation_.character().bodies()[0];
+  double* wrench = simulation_.mutable_data()->xfrc_applied + 6 * root;
+  wrench[0] = force_n * std::cos(heading_rad);
+  wrench[1] = force_n * std::sin(heading_rad);
+  wrench[2] = 0.0;
 }
 
 void TrackingEnv::ReadBodyKinematics() {

@@ -46,6 +46,33 @@ struct ReferenceNoise {
   bool enabled() const { return pixel_sigma_px > 0 || drop_probability > 0; }
 };
 
+// Pushes on the root body: a horizontal force of force_n, in a direction
+// drawn per push, that starts every every_s into an episode (not at its
+// start) and lasts duration_s. The paper's robustness test (`eval --push`:
+// periodic 300 N) and, in training, practice for it. 0 N: no pushes.
+struct PushOptions {
+  double force_n = 0.0;
+  double every_s = 2.0;
+  double duration_s = 0.2;
+
+  template <typename Self, typename Visitor>
+  static void VisitFields(Self& self, Visitor& v) {
+    v("force_n", self.force_n, Range::AtLeast(0),
+      "horizontal force on the root body (N), in a direction drawn per "
+      "push; 0: no pushes");
+    v("every_s", self.every_s, Range::Above(0),
+      "a push starts every this long into an episode (s)");
+    v("duration_s", self.duration_s, Range::Above(0),
+      "each push lasts this long (s; at most every_s)");
+  }
+  void Validate() const;  // throws ConfigError
+};
+
+// Which push acts during control step `step` of an episode (steps at
+// `control_hz`): k >= 1 for the k-th, from k every_s for duration_s; 0
+// between pushes and without them.
+int PushAtStep(int step, double control_hz, const PushOptions& pushes);
+
 struct TrackingEnvOptions {
   SimulationOptions simulation;
   int num_future_frames = 5;               // L reference frames observed ahead
@@ -80,6 +107,7 @@ struct TrackingEnvOptions {
   // early (a kick at frame 11 of 121), is otherwise practised by 1/T of the
   // starts. 0: uniform, drawing nothing extra (runs stay bit-identical).
   double first_frame_start_share = 0.0;
+  PushOptions pushes;  // none by default
 
   // Every setting (common/settings.h); a training config's `env` section
   // (the simulation's fields spliced in, the reward as `env.reward`).
@@ -116,6 +144,7 @@ struct TrackingEnvOptions {
       "share of training episodes that start at their clip's first frame "
       "instead of a uniformly drawn one; 0: uniform");
     v.Nested("reward", self.reward);
+    v.Nested("pushes", self.pushes);
     v("target", self.target, Range::Any(),
       "image_2d (the paper's 2D reprojection reward) or body_3d (the "
       "3D-tracking baselines: a DeepMimic-style reward on the motion the "
@@ -231,6 +260,9 @@ class TrackingEnv {
   // `last_frame` (drawn the first time an episode reaches them).
   void CorruptReferenceUpTo(int last_frame);
   void ProjectCurrentPoints();
+  // A horizontal force of `force_n` at `heading_rad` on the root body
+  // (world frame; 0 N clears it). MuJoCo keeps xfrc_applied until changed.
+  void SetRootPush(double force_n, double heading_rad);
   void ReadBodyKinematics();  // and the objects' (ReadObjectKinematics)
   void ReadObjectKinematics();
   // With critic_observes_3d: the critic-only block of the current frame.
@@ -243,6 +275,7 @@ class TrackingEnv {
   std::shared_ptr<const TrackingReference> reference_;
   std::shared_ptr<const InitialStates> initial_states_;
   TrackingEnvOptions options_;
+  int push_ = 0;  // the push acting (PushAtStep), 0: none
   Simulation simulation_;
   ObservationLayout layout_;
   std::mt19937_64 rng_;

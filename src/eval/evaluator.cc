@@ -51,17 +51,6 @@ void OffsetObjectStarts(const Character& character,
   }
 }
 
-// A horizontal force of `force_n` at `heading_rad` on the root body (world
-// frame; 0 N clears it). MuJoCo keeps xfrc_applied until it is changed; a
-// rollout's start (Simulation::Restore) clears it.
-void SetRootPush(double force_n, double heading_rad, Simulation& simulation) {
-  const int root = simulation.character().bodies()[0];
-  double* wrench = simulation.mutable_data()->xfrc_applied + 6 * root;
-  wrench[0] = force_n * std::cos(heading_rad);
-  wrench[1] = force_n * std::sin(heading_rad);
-  wrench[2] = 0.0;
-}
-
 }  // namespace
 
 void EvalOptions::Validate() const {
@@ -74,25 +63,10 @@ void EvalOptions::Validate() const {
     throw ConfigError("eval: the number of views must be in [1, " +
                       std::to_string(kMaxObservedViews) + "]");
   }
-  if (!(push_force_n >= 0 && std::isfinite(push_force_n)))
-    throw ConfigError("eval: the push force must be finite and >= 0 N");
-  if (!(push_every_s > 0 && push_duration_s > 0 &&
-        push_duration_s <= push_every_s)) {
-    throw ConfigError("eval: pushes need 0 < push duration <= push period (s)");
-  }
+  pushes.Validate();
   if (!(object_start_square_m >= 0 && std::isfinite(object_start_square_m)))
     throw ConfigError(
         "eval: the object start square must be finite and >= 0 m");
-}
-
-int PushAtStep(int step, double control_hz, const EvalOptions& options) {
-  if (options.push_force_n <= 0) return 0;
-  // Steps are compared in time at their start, with half a step's slack
-  // so that 2 s at 30 Hz is step 60 exactly.
-  const double time_s = (step + 0.5) / control_hz;
-  const int k = static_cast<int>(std::floor(time_s / options.push_every_s));
-  if (k < 1) return 0;
-  return time_s - k * options.push_every_s < options.push_duration_s ? k : 0;
 }
 
 std::vector<EvalRow> EvaluatePolicy(
@@ -136,8 +110,11 @@ std::vector<EvalRow> EvaluatePolicy(
   // Every policy is judged by the same 2D criterion, whatever it was
   // trained to follow (a 3D baseline's own 3D exit is off).
   eval_env.reward_3d.early_exit_max_error_m = 0.0;
-  TrackingEnv env(character, reference, initial_states, eval_env, 0,
-                  options.num_views);
+  eval_env.pushes = options.pushes;
+  // The environment's seed draws the push directions (Reset, which would
+  // also draw from it, is not used here).
+  TrackingEnv env(character, reference, initial_states, eval_env,
+                  options.perturbation_seed, options.num_views);
   if (env.observation_size() != policy.observation_size() ||
       env.action_size() != policy.action_size()) {
     throw InputError("policy", "expects " +
@@ -159,7 +136,7 @@ std::vector<EvalRow> EvaluatePolicy(
                      "object (a ball); these track none");
   }
   std::vector<EvalRow> rows;
-  uint64_t rollout_index = 0;  // draws of the perturbations
+  std::mt19937_64 offset_rng(options.perturbation_seed);  // object starts
 
   for (const std::vector<int>& view_set : view_sets) {
     const int v = view_set.front();
@@ -187,29 +164,17 @@ std::vector<EvalRow> EvaluatePolicy(
                       ? 0
                       : last_start * e / (options.episodes_per_view - 1);
       const StateBuffer& buffer = initial_states->BufferOfView(v);
-      std::mt19937_64 perturbation_rng(options.perturbation_seed * 1'000'003 +
-                                       rollout_index++);
       SimState start_state = buffer.entry(start, buffer.Best(start)).state;
       if (options.object_start_square_m > 0) {
         OffsetObjectStarts(*character, reference->object_bodies(),
-                           options.object_start_square_m, perturbation_rng,
+                           options.object_start_square_m, offset_rng,
                            &start_state);
       }
       env.ResetToViews(view_set, start, start_state, observation.data());
       KeypointFrames simulated, true_keypoints;
       double object_error = 0.0;
       int object_frames = 0;
-      int push = 0;  // the push acting (PushAtStep), 0: none
-      std::uniform_real_distribution<double> push_heading_rad(0.0, 2.0 * M_PI);
-      for (int step = 0;; ++step) {
-        const int push_now =
-            PushAtStep(step, eval_env.simulation.control_hz, options);
-        if (push_now != push) {
-          push = push_now;
-          SetRootPush(push > 0 ? options.push_force_n : 0.0,
-                      push > 0 ? push_heading_rad(perturbation_rng) : 0.0,
-                      env.mutable_simulation());
-        }
+      for (;;) {
         policy.Act(observation.data(), 1, action.data());
         StepOutcome outcome = env.Step(action.data(), observation.data());
         if (!outcome.diverged) {

@@ -30,29 +30,18 @@ struct EvalOptions {
   // each of its views in turn, that view with the K - 1 next ones (in the
   // bundle's order, wrapping); it needs the true cameras (one world).
   int num_views = 1;
-  // The paper's robustness tests (its dribble: "w/ Rnd.", the ball placed
-  // at random in a 1 x 1 m area; periodic 300 N pushes). A horizontal force
-  // of push_force_n on the root body, in a direction drawn per push, starts
-  // every push_every_s into a rollout and lasts push_duration_s (0 N: no
-  // pushes). Each tracked object's start is moved by an offset drawn
+  // The paper's robustness tests (its dribble: periodic 300 N pushes;
+  // "w/ Rnd.", the ball placed at random in a 1 x 1 m area). Pushes on the
+  // root as the environment applies them (env/tracking_env.h; none by
+  // default). Each tracked object's start is moved by an offset drawn
   // uniformly in a square of object_start_square_m on the floor (0: none;
-  // needs objects). Draws come from perturbation_seed and the rollout's
-  // index, so an evaluation repeats exactly.
-  double push_force_n = 0.0;
-  double push_every_s = 2.0;
-  double push_duration_s = 0.2;
+  // needs objects). Push directions and offsets are drawn from
+  // perturbation_seed: an evaluation repeats exactly.
+  PushOptions pushes;
   double object_start_square_m = 0.0;
   uint64_t perturbation_seed = 1;
-  bool perturbed() const {
-    return push_force_n > 0 || object_start_square_m > 0;
-  }
   void Validate() const;  // throws ConfigError
 };
-
-// Which push acts during control step `step` of a rollout (steps at
-// `control_hz`): k >= 1 for the k-th, from k push_every_s for
-// push_duration_s; 0 between pushes and without them.
-int PushAtStep(int step, double control_hz, const EvalOptions& options);
 
 // One evaluation rollout (to find which start fails).
 struct EvalRollout {

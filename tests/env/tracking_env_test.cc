@@ -153,6 +153,59 @@ TEST(TrackingEnv, AFirstFrameShareOfStartsBeginsAtTheClipsFirstFrame) {
   EXPECT_THROW(task.options.Validate(), ConfigError);
 }
 
+// env.pushes: the root is pushed with the configured force exactly during
+// the scheduled steps, in a direction drawn per push; a state saved
+// mid-push starts its episode unpushed; pushes move the character.
+TEST(TrackingEnv, PushesActOnTheRootOnScheduleAndNoEpisodeStartsPushed) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
+  task.options.early_exit = false;
+  const SimState start = task.initial_states->buffer(0).entry(0, 0).state;
+  auto root_after = [&](const PushOptions& pushes, SimState* mid_push) {
+    task.options.pushes = pushes;
+    TrackingEnv env(task.character, task.reference, task.initial_states,
+                    task.options, 9);
+    std::vector<float> obs(env.observation_size()),
+        action(env.action_size(), 0.0f);
+    env.ResetTo(0, 0, start, obs.data());
+    const int root = env.simulation().character().bodies()[0];
+    std::vector<double> headings;
+    for (int step = 0; step < 30; ++step) {
+      env.Step(action.data(), obs.data());
+      const double* force = env.simulation().data()->xfrc_applied + 6 * root;
+      const double norm_n = std::hypot(force[0], force[1]);
+      if (PushAtStep(step, 30.0, pushes) > 0) {
+        EXPECT_NEAR(norm_n, pushes.force_n, 1e-9) << step;
+        EXPECT_EQ(force[2], 0.0);
+        headings.push_back(std::atan2(force[1], force[0]));
+        if (mid_push != nullptr) *mid_push = env.simulation().Save();
+      } else {
+        EXPECT_EQ(norm_n, 0.0) << step;
+      }
+    }
+    if (pushes.force_n > 0) {  // steps 15-20: one push, one direction
+      EXPECT_EQ(headings.size(), 6u);
+      EXPECT_EQ(headings.front(), headings.back());
+    }
+    return Eigen::Vector3d(env.simulation().data()->qpos);
+  };
+  SimState mid_push;
+  const Eigen::Vector3d pushed = root_after({800.0, 0.5, 0.2}, &mid_push);
+  const Eigen::Vector3d still = root_after({}, nullptr);
+  EXPECT_GT((pushed - still).head<2>().norm(), 0.05);
+
+  task.options.pushes = {800.0, 0.5, 0.2};
+  TrackingEnv env(task.character, task.reference, task.initial_states,
+                  task.options, 9);
+  std::vector<float> obs(env.observation_size());
+  env.ResetTo(0, 0, mid_push, obs.data());
+  const int root = env.simulation().character().bodies()[0];
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(env.simulation().data()->xfrc_applied[6 * root + i], 0.0);
+  task.options.pushes.duration_s = 0.6;  // longer than the period
+  EXPECT_THROW(task.options.Validate(), ConfigError);
+}
+
 // Zero and random actions for 10 000 control steps each (4 envs): no NaN in
 // any observation or reward, no crash; episodes end and restart.
 TEST(VecEnv, ZeroAndRandomActionRolloutsStayFinite) {

@@ -263,36 +263,38 @@ TEST(EvaluatePolicy, InvalidOptionsAreRejected) {
                ConfigError);
 }
 
-// Pushes start every push_every_s into a rollout (not at its start) and
-// last push_duration_s, whole control steps at the control rate.
+// Pushes start every every_s into an episode (not at its start) and last
+// duration_s, whole control steps at the control rate.
 TEST(EvaluatePolicy, PushesFollowTheirScheduleInControlSteps) {
-  EvalOptions options;
-  EXPECT_EQ(PushAtStep(60, 30.0, options), 0);  // no force: no push
-  options.push_force_n = 300.0;                 // every 2 s for 0.2 s
-  EXPECT_EQ(PushAtStep(0, 30.0, options), 0);
-  EXPECT_EQ(PushAtStep(59, 30.0, options), 0);
+  PushOptions pushes;
+  EXPECT_EQ(PushAtStep(60, 30.0, pushes), 0);  // no force: no push
+  pushes.force_n = 300.0;                      // every 2 s for 0.2 s
+  EXPECT_EQ(PushAtStep(0, 30.0, pushes), 0);
+  EXPECT_EQ(PushAtStep(59, 30.0, pushes), 0);
   for (int step = 60; step < 66; ++step)
-    EXPECT_EQ(PushAtStep(step, 30.0, options), 1) << step;
-  EXPECT_EQ(PushAtStep(66, 30.0, options), 0);
-  EXPECT_EQ(PushAtStep(119, 30.0, options), 0);
-  EXPECT_EQ(PushAtStep(120, 30.0, options), 2);
-  options.push_duration_s = options.push_every_s;  // one push after another
-  EXPECT_EQ(PushAtStep(119, 30.0, options), 1);
-  EXPECT_EQ(PushAtStep(120, 30.0, options), 2);
-  options.push_duration_s = 3.0;  // longer than the period
+    EXPECT_EQ(PushAtStep(step, 30.0, pushes), 1) << step;
+  EXPECT_EQ(PushAtStep(66, 30.0, pushes), 0);
+  EXPECT_EQ(PushAtStep(119, 30.0, pushes), 0);
+  EXPECT_EQ(PushAtStep(120, 30.0, pushes), 2);
+  pushes.duration_s = pushes.every_s;  // one push after another
+  EXPECT_EQ(PushAtStep(119, 30.0, pushes), 1);
+  EXPECT_EQ(PushAtStep(120, 30.0, pushes), 2);
+  EvalOptions options;
+  options.pushes = pushes;
+  options.pushes.duration_s = 3.0;  // longer than the period
   EXPECT_THROW(options.Validate(), ConfigError);
-  options.push_duration_s = 0.2;
-  options.push_force_n = -1.0;
+  options.pushes.duration_s = 0.2;
+  options.pushes.force_n = -1.0;
   EXPECT_THROW(options.Validate(), ConfigError);
-  options.push_force_n = 0.0;
+  options.pushes.force_n = 0.0;
   options.object_start_square_m = std::nan("");
   EXPECT_THROW(options.Validate(), ConfigError);
 }
 
 // A policy that ignores what it sees rolls the same motion out in every
 // view (AGenerousThreshold... above); pushed, each rollout goes its own way
-// (a direction drawn per push and rollout), farther from the truth, and the
-// same seed repeats the evaluation exactly.
+// (a direction drawn per push), farther from the truth, and the same seed
+// repeats the evaluation exactly.
 TEST(EvaluatePolicy, PushesMoveTheCharacterAndRepeatForASeed) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
@@ -307,8 +309,8 @@ TEST(EvaluatePolicy, PushesMoveTheCharacterAndRepeatForASeed) {
                           {task.reference->bundles()[0].ground_truth});
   };
   const std::vector<EvalRow> still = evaluate(options);
-  options.push_force_n = 1000.0;
-  options.push_every_s = 0.5;
+  options.pushes.force_n = 1000.0;
+  options.pushes.every_s = 0.5;
   const std::vector<EvalRow> pushed = evaluate(options);
   const std::vector<EvalRow> again = evaluate(options);
   ASSERT_EQ(pushed.size(), 4u);
