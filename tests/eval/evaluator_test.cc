@@ -22,6 +22,23 @@ ZeroPolicy MakeZeroPolicy(const testing::WalkTask& task) {
   return ZeroPolicy(env.observation_size(), env.action_size());
 }
 
+// Rollouts no frame can fail (1e6 px): each runs its length.
+EvalOptions RunToLength(int episodes_per_view, double episode_s) {
+  EvalOptions options;
+  options.episodes_per_view = episodes_per_view;
+  options.episode_s = episode_s;
+  options.success_threshold_px = 1e6;
+  return options;
+}
+
+// `task`'s walk evaluated with its 3D truth.
+std::vector<EvalRow> EvaluateWalk(Policy& policy, const testing::WalkTask& task,
+                                  const EvalOptions& options) {
+  return EvaluatePolicy(policy, task.character, task.reference,
+                        task.initial_states, task.options, options,
+                        {task.reference->bundles()[0].ground_truth});
+}
+
 TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
@@ -109,13 +126,7 @@ TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
   ZeroPolicy policy = MakeZeroPolicy(task);
-  EvalOptions options;
-  options.episodes_per_view = 3;
-  options.episode_s = 0.5;
-  options.success_threshold_px = 1e6;  // no frame can fail
-  std::vector<EvalRow> rows = EvaluatePolicy(
-      policy, task.character, task.reference, task.initial_states, task.options,
-      options, {task.reference->bundles()[0].ground_truth});
+  std::vector<EvalRow> rows = EvaluateWalk(policy, task, RunToLength(3, 0.5));
   ASSERT_EQ(rows.size(), task.reference->views().size());
   for (const EvalRow& row : rows) {
     SCOPED_TRACE(row.view);
@@ -299,14 +310,9 @@ TEST(EvaluatePolicy, PushesMoveTheCharacterAndRepeatForASeed) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
   ZeroPolicy policy = MakeZeroPolicy(task);
-  EvalOptions options;
-  options.episodes_per_view = 1;
-  options.episode_s = 1.5;
-  options.success_threshold_px = 1e6;  // every rollout runs its length
+  EvalOptions options = RunToLength(1, 1.5);
   auto evaluate = [&](const EvalOptions& eval_options) {
-    return EvaluatePolicy(policy, task.character, task.reference,
-                          task.initial_states, task.options, eval_options,
-                          {task.reference->bundles()[0].ground_truth});
+    return EvaluateWalk(policy, task, eval_options);
   };
   const std::vector<EvalRow> still = evaluate(options);
   options.pushes.force_n = 1000.0;
@@ -347,10 +353,7 @@ TEST(EvaluatePolicy, ObjectStartsMoveWithinTheirSquare) {
   TrackingEnv env(task.character, task.reference, task.initial_states,
                   env_options, 0);
   ZeroPolicy policy(env.observation_size(), env.action_size());
-  EvalOptions options;
-  options.episodes_per_view = 1;
-  options.episode_s = 0.3;
-  options.success_threshold_px = 1e6;
+  EvalOptions options = RunToLength(1, 0.3);
   auto eo2d = [&](double square_m) {
     options.object_start_square_m = square_m;
     return AggregateRows(EvaluatePolicy(policy, task.character, task.reference,
