@@ -76,7 +76,6 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   const int num_keypoints = character->keypoint_layout().num_keypoints();
   keypoints_xyz_.resize(3 * num_keypoints);
   current_points_m_.resize(num_points);
-  future_points_m_.resize(num_points);
   projected_xy_.resize(2 * num_points * num_observed_views);
   in_front_.reset(new bool[num_points * num_observed_views]);
   projected_points_.resize(num_points * num_observed_views);
@@ -406,25 +405,26 @@ void TrackingEnv::WriteObservation(float* observation) {
         InverseHeadingRotation(bodies_.orientations[0]);
     float* out = observation + layout_.view_offset();
     const int stride = num_points * ObservationLayout::kPointFeatures;
-    const int num_keypoints = num_points - layout_.num_objects;
+    // Points are 3 floats each, keypoints first: the objects follow them.
+    const int num_objects = layout_.num_objects;
+    const int num_keypoints = num_points - num_objects;
+    const int objects_offset = 3 * num_keypoints;
     for (int j = 0; j < num_keypoints; ++j) {
       current_points_m_[j] = {keypoints_xyz_[3 * j], keypoints_xyz_[3 * j + 1],
                               keypoints_xyz_[3 * j + 2]};
     }
-    std::copy(object_positions_.begin(), object_positions_.end(),
-              current_points_m_.begin() + num_keypoints);
-    WriteRootRelativePoints(current_points_m_.data(), num_points, root,
+    WriteRootRelativePoints(current_points_m_.data(), num_keypoints, root,
                             to_heading, out);
+    WriteRootRelativePoints(object_positions_.data(), num_objects, root,
+                            to_heading, out + objects_offset);
     for (int l = 1; l <= layout_.num_future_frames; ++l) {
       const BodyTarget3D& future =
           ReferenceBody(std::min(frame_ + l, view_->num_frames - 1));
-      std::copy(future.keypoints_m.begin(), future.keypoints_m.end(),
-                future_points_m_.begin());
-      std::copy(future.object_positions_m.begin(),
-                future.object_positions_m.end(),
-                future_points_m_.begin() + num_keypoints);
-      WriteRootRelativePoints(future_points_m_.data(), num_points, root,
+      WriteRootRelativePoints(future.keypoints_m.data(), num_keypoints, root,
                               to_heading, out + l * stride);
+      WriteRootRelativePoints(future.object_positions_m.data(), num_objects,
+                              root, to_heading,
+                              out + l * stride + objects_offset);
     }
     return;
   }

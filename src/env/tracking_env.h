@@ -306,8 +306,7 @@ class TrackingEnv {
   std::vector<Keypoint2D> projected_points_;
   std::vector<Eigen::Vector3d> object_positions_, object_velocities_;
   BodyTarget3D simulated_body_;                    // target body_3d
-  std::vector<Eigen::Vector3d> current_points_m_;  // target body_3d
-  std::vector<Eigen::Vector3d> future_points_m_;   // target body_3d
+  std::vector<Eigen::Vector3d> current_points_m_;  // target body_3d keypoints
 };
 
 }  // namespace m2d
