@@ -28,6 +28,20 @@ int PushAtStep(int step, double control_hz, const PushOptions& pushes) {
   return time_s - k * pushes.every_s < pushes.duration_s ? k : 0;
 }
 
+void OffsetObjectStarts(const Character& character,
+                        const std::vector<int>& object_bodies, double square_m,
+                        std::mt19937_64& rng, SimState* state) {
+  std::uniform_real_distribution<double> offset_m(-0.5 * square_m,
+                                                  0.5 * square_m);
+  for (const FreeObject& object : character.free_objects()) {
+    if (std::find(object_bodies.begin(), object_bodies.end(), object.body_id) ==
+        object_bodies.end())
+      continue;
+    state->qpos[object.qpos_address] += offset_m(rng);
+    state->qpos[object.qpos_address + 1] += offset_m(rng);
+  }
+}
+
 void TrackingEnvOptions::Validate() const {
   CheckRanges(*this, "env");
   pushes.Validate();
@@ -62,6 +76,12 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
           "env: target body_3d needs a 3D reference: initial_states truth "
           "or estimate, not default");
     }
+  }
+  if (options_.object_start_square_m > 0 &&
+      reference_->num_object_points() == 0) {
+    throw ConfigError(
+        "env: object_start_square_m moves tracked objects (a ball); these "
+        "bundles track none");
   }
   layout_.num_bodies = static_cast<int>(character->bodies().size());
   layout_.num_objects = reference_->num_object_points();
@@ -129,7 +149,7 @@ void TrackingEnv::ResetTo(int view_index, int frame, const SimState& state,
                       std::to_string(num_observed_views_) +
                       " views starts with ResetToViews");
   }
-  simulation_.Restore(state);
+  RestoreStart(state);
   observed_views_[0] = &reference_->views()[view_index];
   episode_.view_index = view_index;
   BeginEpisode(frame);
@@ -157,11 +177,22 @@ void TrackingEnv::ResetToViews(const std::vector<int>& view_indices, int frame,
     }
     observed_views_[k] = &views[index];
   }
-  simulation_.Restore(state);
+  RestoreStart(state);
   episode_.view_index = view_indices[0];
   BeginEpisode(frame);
   ProjectCurrentPoints();
   WriteObservation(observation);
+}
+
+void TrackingEnv::RestoreStart(const SimState& state) {
+  if (options_.object_start_square_m <= 0) {
+    simulation_.Restore(state);
+    return;
+  }
+  moved_start_ = state;
+  OffsetObjectStarts(simulation_.character(), reference_->object_bodies(),
+                     options_.object_start_square_m, rng_, &moved_start_);
+  simulation_.Restore(moved_start_);
 }
 
 void TrackingEnv::BeginEpisode(int frame) {

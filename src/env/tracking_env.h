@@ -73,6 +73,13 @@ struct PushOptions {
 // between pushes and without them.
 int PushAtStep(int step, double control_hz, const PushOptions& pushes);
 
+// Moves each tracked object (`object_bodies`) of `state` on the floor by an
+// offset drawn uniformly in a square of side `square_m` about where it was
+// (x and y, two draws per object, in free_objects() order).
+void OffsetObjectStarts(const Character& character,
+                        const std::vector<int>& object_bodies, double square_m,
+                        std::mt19937_64& rng, SimState* state);
+
 struct TrackingEnvOptions {
   SimulationOptions simulation;
   int num_future_frames = 5;               // L reference frames observed ahead
@@ -108,6 +115,12 @@ struct TrackingEnvOptions {
   // starts. 0: uniform, drawing nothing extra (runs stay bit-identical).
   double first_frame_start_share = 0.0;
   PushOptions pushes;  // none by default
+  // Moved objects: every episode's tracked objects (a ball) start offset on
+  // the floor, uniformly in a square of this side (m) about where the start
+  // state has them, drawn from the environment's seed. The paper's "w/ Rnd."
+  // test (`eval --object-start-square 1`) and, in training, practice for it.
+  // 0: where the start state has them.
+  double object_start_square_m = 0.0;
 
   // Every setting (common/settings.h); a training config's `env` section
   // (the simulation's fields spliced in, the reward as `env.reward`).
@@ -145,6 +158,10 @@ struct TrackingEnvOptions {
       "instead of a uniformly drawn one; 0: uniform");
     v.Nested("reward", self.reward);
     v.Nested("pushes", self.pushes);
+    v("object_start_square_m", self.object_start_square_m, Range::AtLeast(0),
+      "each episode's tracked objects (the ball) start moved on the floor "
+      "uniformly within a square of this side (m) about their start; 0: "
+      "not moved");
     v("target", self.target, Range::Any(),
       "image_2d (the paper's 2D reprojection reward) or body_3d (the "
       "3D-tracking baselines: a DeepMimic-style reward on the motion the "
@@ -255,6 +272,9 @@ class TrackingEnv {
   void WriteObservation(float* observation);
 
  private:
+  // Restores `state` as an episode's start, the objects moved when
+  // object_start_square_m asks for it (its copy: the buffers keep theirs).
+  void RestoreStart(const SimState& state);
   void BeginEpisode(int frame);
   // With reference noise: the episode's noisy views hold frames up to
   // `last_frame` (drawn the first time an episode reaches them).
@@ -275,7 +295,8 @@ class TrackingEnv {
   std::shared_ptr<const TrackingReference> reference_;
   std::shared_ptr<const InitialStates> initial_states_;
   TrackingEnvOptions options_;
-  int push_ = 0;  // the push acting (PushAtStep), 0: none
+  int push_ = 0;          // the push acting (PushAtStep), 0: none
+  SimState moved_start_;  // RestoreStart's copy, reused
   Simulation simulation_;
   ObservationLayout layout_;
   std::mt19937_64 rng_;

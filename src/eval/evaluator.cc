@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 #include "common/error.h"
 #include "eval/metrics.h"
@@ -33,22 +32,6 @@ std::vector<std::vector<int>> ViewSets(const TrackingReference& reference,
     }
   }
   return sets;
-}
-
-// Moves each tracked object (`object_bodies`) of `state` on the floor by an
-// offset drawn uniformly in a square of side `square_m` about where it was.
-void OffsetObjectStarts(const Character& character,
-                        const std::vector<int>& object_bodies, double square_m,
-                        std::mt19937_64& rng, SimState* state) {
-  std::uniform_real_distribution<double> offset_m(-0.5 * square_m,
-                                                  0.5 * square_m);
-  for (const FreeObject& object : character.free_objects()) {
-    if (std::find(object_bodies.begin(), object_bodies.end(), object.body_id) ==
-        object_bodies.end())
-      continue;
-    state->qpos[object.qpos_address] += offset_m(rng);
-    state->qpos[object.qpos_address + 1] += offset_m(rng);
-  }
 }
 
 }  // namespace
@@ -111,8 +94,15 @@ std::vector<EvalRow> EvaluatePolicy(
   // trained to follow (a 3D baseline's own 3D exit is off).
   eval_env.reward_3d.early_exit_max_error_m = 0.0;
   eval_env.pushes = options.pushes;
-  // The environment's seed draws the push directions (Reset, which would
-  // also draw from it, is not used here).
+  eval_env.object_start_square_m = options.object_start_square_m;
+  if (options.object_start_square_m > 0 &&
+      reference->num_object_points() == 0) {
+    throw InputError("evaluation",
+                     "moving the objects' starts needs bundles that track an "
+                     "object (a ball); these track none");
+  }
+  // The environment's seed draws the push directions and the objects'
+  // offsets (Reset, which would also draw from it, is not used here).
   TrackingEnv env(character, reference, initial_states, eval_env,
                   options.perturbation_seed, options.num_views);
   if (env.observation_size() != policy.observation_size() ||
@@ -129,14 +119,7 @@ std::vector<EvalRow> EvaluatePolicy(
       action(env.action_size());
   const int episode_frames = eval_env.max_episode_steps();
   const KeypointLayout& layout = character->keypoint_layout();
-  if (options.object_start_square_m > 0 &&
-      reference->num_object_points() == 0) {
-    throw InputError("evaluation",
-                     "moving the objects' starts needs bundles that track an "
-                     "object (a ball); these track none");
-  }
   std::vector<EvalRow> rows;
-  std::mt19937_64 offset_rng(options.perturbation_seed);  // object starts
 
   for (const std::vector<int>& view_set : view_sets) {
     const int v = view_set.front();
@@ -164,12 +147,8 @@ std::vector<EvalRow> EvaluatePolicy(
                       ? 0
                       : last_start * e / (options.episodes_per_view - 1);
       const StateBuffer& buffer = initial_states->BufferOfView(v);
-      SimState start_state = buffer.entry(start, buffer.Best(start)).state;
-      if (options.object_start_square_m > 0) {
-        OffsetObjectStarts(*character, reference->object_bodies(),
-                           options.object_start_square_m, offset_rng,
-                           &start_state);
-      }
+      const SimState& start_state =
+          buffer.entry(start, buffer.Best(start)).state;
       env.ResetToViews(view_set, start, start_state, observation.data());
       KeypointFrames simulated, true_keypoints;
       double object_error = 0.0;

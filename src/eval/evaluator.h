@@ -32,10 +32,9 @@ struct EvalOptions {
   int num_views = 1;
   // The paper's robustness tests (its dribble: periodic 300 N pushes;
   // "w/ Rnd.", the ball placed at random in a 1 x 1 m area). Pushes on the
-  // root as the environment applies them (env/tracking_env.h; none by
-  // default). Each tracked object's start is moved by an offset drawn
-  // uniformly in a square of object_start_square_m on the floor (0: none;
-  // needs objects). Push directions and offsets are drawn from
+  // root and objects moved within a square of object_start_square_m on the
+  // floor (0: none; needs objects), both as the environment applies them in
+  // training (env/tracking_env.h). Push directions and offsets are drawn from
   // perturbation_seed: an evaluation repeats exactly.
   PushOptions pushes;
   double object_start_square_m = 0.0;

@@ -2,6 +2,7 @@
 // and the starts that place it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/error.h"
@@ -148,6 +149,81 @@ TEST(TrackingEnvWithObject, StartsPlaceTheBallFromEachSource) {
     seen_rolling += t > 9;
   }
   EXPECT_GT(seen_rolling, 3);
+}
+
+// The paper's "w/ Rnd." as a setting: every start moves the ball (only) by
+// an offset uniform in the square, drawn from the environment's seed; the
+// buffer's state stays as it was; no square, no move; bundles without an
+// object refuse the setting.
+TEST(TrackingEnvWithObject, MovedStartsOffsetTheBallWithinItsSquare) {
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  TrackingEnvOptions options;
+  options.object_start_square_m = 1.0;
+  auto character = LoadCharacterForSimulation(
+      testing::SourcePath("assets/characters/humanoid.yaml"), "ball",
+      options.simulation);
+  const FreeObject& ball = character->free_objects()[0];
+  ReferenceBundle bundle = testing::MakeWalkBundle(path, *character, 1.0);
+  testing::AddRestingBall(*character, &bundle);
+  auto reference = TrackingReference::Prepare({bundle}, *character,
+                                              options.simulation.control_hz);
+  auto states = std::make_shared<InitialStates>(
+      *reference, character, options.simulation, StateBufferOptions());
+  const SimState& start = states->buffer(0).entry(0, 0).state;
+  const std::vector<double> start_qpos = start.qpos;
+  std::vector<float> obs;
+  // The ball's offset from the start state, and the largest change
+  // elsewhere in qpos, after one ResetTo.
+  auto reset_offset = [&](TrackingEnv& env, double* other_change) {
+    obs.resize(env.observation_size());
+    env.ResetTo(0, 0, start, obs.data());
+    const double* qpos = env.simulation().data()->qpos;
+    *other_change = 0;
+    for (size_t i = 0; i < start_qpos.size(); ++i) {
+      if (i == size_t(ball.qpos_address) || i == size_t(ball.qpos_address) + 1)
+        continue;
+      *other_change =
+          std::max(*other_change, std::abs(qpos[i] - start_qpos[i]));
+    }
+    return Eigen::Vector2d(
+        qpos[ball.qpos_address] - start_qpos[ball.qpos_address],
+        qpos[ball.qpos_address + 1] - start_qpos[ball.qpos_address + 1]);
+  };
+
+  TrackingEnv env(character, reference, states, options, 3);
+  Eigen::Vector2d low(1, 1), high(-1, -1);
+  for (int i = 0; i < 200; ++i) {
+    double other_change = 0;
+    const Eigen::Vector2d offset = reset_offset(env, &other_change);
+    EXPECT_EQ(other_change, 0.0);
+    low = low.cwiseMin(offset);
+    high = high.cwiseMax(offset);
+  }
+  EXPECT_GE(low.minCoeff(), -0.5);
+  EXPECT_LE(high.maxCoeff(), 0.5);
+  EXPECT_LT(low.maxCoeff(), -0.4);  // the square is covered, not a corner
+  EXPECT_GT(high.minCoeff(), 0.4);
+  EXPECT_EQ(states->buffer(0).entry(0, 0).state.qpos, start_qpos);
+  double other_change = 0;
+  TrackingEnv same_seed(character, reference, states, options, 3);
+  TrackingEnv again(character, reference, states, options, 3);
+  EXPECT_EQ(reset_offset(same_seed, &other_change),
+            reset_offset(again, &other_change));
+
+  options.object_start_square_m = 0.0;
+  TrackingEnv unmoved(character, reference, states, options, 3);
+  EXPECT_EQ(reset_offset(unmoved, &other_change), Eigen::Vector2d::Zero());
+
+  options.object_start_square_m = 1.0;
+  testing::WalkTask no_ball = testing::MakeWalkTask(path, 1.0);
+  try {
+    TrackingEnv refused(no_ball.character, no_ball.reference,
+                        no_ball.initial_states, options, 3);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("track none"), std::string::npos)
+        << error.what();
+  }
 }
 
 // The two-stage baseline with a ball (target body_3d): the initial states'
