@@ -28,6 +28,11 @@ int PushAtStep(int step, double control_hz, const PushOptions& pushes) {
   return time_s - k * pushes.every_s < pushes.duration_s ? k : 0;
 }
 
+namespace {
+
+// Moves each tracked object (`object_bodies`) of `state` on the floor by an
+// offset drawn uniformly in a square of side `square_m` about where it was
+// (x and y, two draws per object, in free_objects() order).
 void OffsetObjectStarts(const Character& character,
                         const std::vector<int>& object_bodies, double square_m,
                         std::mt19937_64& rng, SimState* state) {
@@ -41,6 +46,8 @@ void OffsetObjectStarts(const Character& character,
     state->qpos[object.qpos_address + 1] += offset_m(rng);
   }
 }
+
+}  // namespace
 
 void TrackingEnvOptions::Validate() const {
   CheckRanges(*this, "env");

@@ -73,13 +73,6 @@ struct PushOptions {
 // between pushes and without them.
 int PushAtStep(int step, double control_hz, const PushOptions& pushes);
 
-// Moves each tracked object (`object_bodies`) of `state` on the floor by an
-// offset drawn uniformly in a square of side `square_m` about where it was
-// (x and y, two draws per object, in free_objects() order).
-void OffsetObjectStarts(const Character& character,
-                        const std::vector<int>& object_bodies, double square_m,
-                        std::mt19937_64& rng, SimState* state);
-
 struct TrackingEnvOptions {
   SimulationOptions simulation;
   int num_future_frames = 5;               // L reference frames observed ahead
