@@ -140,7 +140,8 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
   fit->add_option("--threads", args->threads, "Ceres threads per fit")
       ->capture_default_str();
   fit->add_option("-o,--output", args->output,
-                  "Write the table as JSON (atomically)");
+                  "Write the table as JSON (atomically)")
+      ->check(WritableFile());
   fit->add_option("--motion-dir", args->motion_dir,
                   "Folder of the clips (default: assets/motions/deepmimic)");
   fit->add_option("--config", args->config,

@@ -120,6 +120,7 @@ void AddCheckpointCommand(CLI::App& app, CommandRun* run) {
       ->check(CLI::ExistingFile);
   slim->add_option("-o,--output", args->output,
                    "Where to write it (may be the input)")
+      ->check(WritableFile())
       ->required();
   slim->callback([run, args] { *run = [args] { return RunSlim(*args); }; });
 }

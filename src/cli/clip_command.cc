@@ -217,9 +217,12 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
   AddMotionSourceOptions(*from_motion, &from->source);
   from_motion
       ->add_option("-o,--output", from->output, "Bundle file to write (JSON)")
+      ->check(WritableFile())
       ->required();
-  from_motion->add_option("--cameras-output", from->cameras_output,
-                          "Also write the rig as a camera set (JSON)");
+  from_motion
+      ->add_option("--cameras-output", from->cameras_output,
+                   "Also write the rig as a camera set (JSON)")
+      ->check(WritableFile());
   AddBundleOptions(*from_motion, &from->options, &from->follow);
   from_motion->add_option(
       "--ball", from->ball,
@@ -239,6 +242,7 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
                    "Detections: a JSON file or an OpenPose folder")
       ->required();
   convert_cmd->add_option("-o,--output", convert->output, "Clip file to write")
+      ->check(WritableFile())
       ->required();
   convert_cmd->add_option("--track-id", convert->read.track_id,
                           "Person to follow (-1: the largest per frame)");
@@ -259,6 +263,7 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
   strip_cmd->add_option("bundle", strip->input, "Bundle JSON to strip")
       ->required();
   strip_cmd->add_option("-o,--output", strip->output, "Bundle file to write")
+      ->check(WritableFile())
       ->required();
   strip_cmd->callback(
       [run, strip] { *run = [strip] { return RunStrip(*strip); }; });
@@ -270,6 +275,7 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
       "video's clip at the 30 Hz control rate");
   resample_cmd->add_option("clip", resample->input, "Clip JSON")->required();
   resample_cmd->add_option("-o,--output", resample->output, "Clip to write")
+      ->check(WritableFile())
       ->required();
   resample_cmd->add_option("--fps", resample->fps, "Frame rate (Hz)")
       ->capture_default_str();

@@ -38,6 +38,11 @@ std::string AssetPath(const std::string& relative);
 // relative to assets/ (e.g. --character characters/humanoid.yaml).
 std::string AssetArgumentPath(const std::string& argument);
 
+// A check for an output file's option: the command line is refused, before
+// any work, when no file could be written at the path (the option and the
+// problem named; common/file_io.h's WritableFileProblem).
+const CLI::Validator& WritableFile();
+
 }  // namespace m2d::cli
 
 #endif  // MIMIC2D_CLI_COMMANDS_H_

@@ -131,7 +131,8 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
   eval->add_option("--perturbation-seed", args->options.perturbation_seed,
                    "Seed of the push directions and object offsets")
       ->capture_default_str();
-  eval->add_option("-o,--output", args->output, "Write the table as JSON here");
+  eval->add_option("-o,--output", args->output, "Write the table as JSON here")
+      ->check(WritableFile());
   eval->callback([run, args] { *run = [args] { return RunEval(*args); }; });
 }
 

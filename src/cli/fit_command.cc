@@ -147,7 +147,8 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
   fit->add_option("input", args->input,
                   "reference bundle (2D; truth unused) or a 2D clip (one "
                   "view, e.g. from `mimic2d keypoints`)");
-  fit->add_option("-o,--output", args->output, "bundle with the estimate");
+  fit->add_option("-o,--output", args->output, "bundle with the estimate")
+      ->check(WritableFile());
   fit->add_flag("--list-settings", args->list_settings,
                 "Print every --config setting with its default, allowed "
                 "values and meaning (Markdown), and exit");

@@ -630,7 +630,8 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
   eval->add_option("--time-segments", eval_args->options.time_segments,
                    "Also score each generation's k-th part of this many "
                    "alone (drift as the context slides)");
-  eval->add_option("-o,--output", eval_args->output, "Figures as JSON");
+  eval->add_option("-o,--output", eval_args->output, "Figures as JSON")
+      ->check(WritableFile());
   eval->callback([run, eval_args] {
     *run = [eval_args] { return RunGenEval(*eval_args); };
   });
@@ -645,6 +646,7 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->check(CLI::ExistingDirectory);
   generate
       ->add_option("-o,--output", generate_args->output, "Clip to write (JSON)")
+      ->check(WritableFile())
       ->required();
   generate->add_option("--seconds", generate_args->seconds,
                        "Length of the generated motion (s)");

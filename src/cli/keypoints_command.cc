@@ -186,6 +186,7 @@ void AddKeypointsCommand(CLI::App& app, CommandRun* run) {
   command->add_option("video", args->video, "Video (or image) file")
       ->required();
   command->add_option("-o,--output", args->output, "Clip file to write (JSON)")
+      ->check(WritableFile())
       ->required();
   command
       ->add_option("--model", args->model,

@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "common/blas_kernels.h"
 #include "common/error.h"
+#include "common/file_io.h"
 
 namespace m2d::cli {
 
@@ -23,6 +24,17 @@ std::string AssetPath(const std::string& relative) {
 std::string AssetArgumentPath(const std::string& argument) {
   return !argument.empty() && argument[0] == '/' ? argument
                                                  : AssetPath(argument);
+}
+
+const CLI::Validator& WritableFile() {
+  static const CLI::Validator validator(
+      [](std::string& path) {
+        const std::string problem = WritableFileProblem(path);
+        return problem.empty() ? problem
+                               : "cannot write " + path + ": " + problem;
+      },
+      "FILE", "WritableFile");
+  return validator;
 }
 
 }  // namespace m2d::cli

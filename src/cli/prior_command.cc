@@ -104,6 +104,7 @@ void AddPriorCommand(CLI::App& app, CommandRun* run) {
       ->required()
       ->check(CLI::ExistingFile);
   prior->add_option("-o,--output", args->output, "the mixture (JSON)")
+      ->check(WritableFile())
       ->required();
   prior
       ->add_option("--character", args->character,

@@ -75,8 +75,10 @@ void AddRenderCommand(CLI::App& app, CommandRun* run) {
       "the character's projected keypoints (red) drawn over");
   render->add_option("bundle", args->bundle, "Reference bundle (JSON)")
       ->required();
-  render->add_option("-o,--output", args->replay.output.video_path,
-                     "MP4 file to write");
+  render
+      ->add_option("-o,--output", args->replay.output.video_path,
+                   "MP4 file to write")
+      ->check(WritableFile());
   render->add_option("--png-dir", args->replay.output.png_folder,
                      "Also write every frame as frame_<n>.png here");
   render->add_flag_function(

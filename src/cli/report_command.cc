@@ -52,6 +52,7 @@ void AddReportCommand(CLI::App& app, CommandRun* run) {
       "One self-contained HTML page (opens offline) with the evaluation "
       "table, training curves and videos of a run");
   report->add_option("-o,--output", args->output, "HTML file to write")
+      ->check(WritableFile())
       ->required();
   report->add_option("--title", args->title, "Page title")
       ->capture_default_str();

@@ -87,6 +87,26 @@ void WriteFileAtomic(const std::string& path, const std::string& contents) {
   }
 }
 
+std::string WritableFileProblem(const std::string& path) {
+  // Outline: the path itself must not be a folder; the nearest existing
+  // ancestor (the working directory for a relative path whose folders are
+  // all missing) must be a folder this process may write into.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty()) return "no path given";
+  if (fs::is_directory(path, ec)) return "is a folder, not a file";
+  fs::path folder = fs::path(path).parent_path();
+  while (!folder.empty() && !fs::exists(folder, ec))
+    folder = folder.parent_path();
+  if (folder.empty()) folder = ".";
+  if (!fs::is_directory(folder, ec))
+    return folder.string() + " is a file, not a folder";
+  if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    return "folder " + folder.string() + " is not writable (" +
+           std::strerror(errno) + ")";
+  return "";
+}
+
 nlohmann::json ReadJsonFile(const std::string& path) {
   std::string text = ReadFileText(path);
   // No file of ours nests deeper than a few levels; a document nested

@@ -17,6 +17,12 @@ std::string ReadFileText(const std::string& path);
 // leaves either the old file or the new one, never a torn one.
 void WriteFileAtomic(const std::string& path, const std::string& contents);
 
+// Why no file could be written at `path` by WriteFileAtomic, or "" when
+// one could: the path is a folder, the nearest existing folder above it is
+// a file, or that folder is not writable (missing folders are created on
+// write). For checking outputs before the work that produces them.
+std::string WritableFileProblem(const std::string& path);
+
 // Parses JSON; InputError naming the path and the parser's position.
 nlohmann::json ReadJsonFile(const std::string& path);
 void WriteJsonFileAtomic(const std::string& path, const nlohmann::json& json,

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "cli/cli_test_util.h"
 #include "common/file_io.h"
@@ -510,6 +512,51 @@ TEST(Cli, BadSettingsAreRejected) {
   EXPECT_NE(result.output.find("num_views must be in [1, 256]"),
             std::string::npos)
       << result.output;
+}
+
+// An output that cannot be written is refused when the command line is
+// read (CLI11's validation error, exit 105), before the work: a folder
+// given as the file, or a "folder" that is a file. Missing folders are
+// fine, relative (from the working directory) or absolute.
+TEST(Cli, OutputsThatCannotBeWrittenAreRefusedBeforeAnyWork) {
+  M2D_REQUIRE_SHARED(walk, "deepmimic/motions/humanoid3d_walk.txt");
+  const std::string dir = testing::TempDir("cli_outputs");
+  const std::string file = WriteFile(dir, "plain.txt", "not a folder");
+  const std::string model =
+      std::string(MIMIC2D_SOURCE_DIR) + "/assets/policies/walk2d/checkpoint.pt";
+  struct Refused {
+    std::string arguments, path, problem;
+  };
+  const std::vector<Refused> refused = {
+      {"eval " + model + " -o " + dir, dir, "is a folder, not a file"},
+      {"fit " + walk + " -o " + file + "/fitted.json", file + "/fitted.json",
+       file + " is a file, not a folder"},
+      {"clip from-motion " + walk + " -o " + file + "/a/b.json",
+       file + "/a/b.json", file + " is a file, not a folder"},
+      {"render " + walk + " -o " + dir, dir, "is a folder, not a file"},
+      {"clip strip " + walk + " -o " + dir, dir, "is a folder, not a file"},
+  };
+  for (const Refused& r : refused) {
+    SCOPED_TRACE(r.arguments);
+    CommandResult result = RunMimic2d(r.arguments);
+    EXPECT_EQ(result.exit_code, 105) << result.output;
+    EXPECT_NE(result.output.find("--output"), std::string::npos)
+        << result.output;
+    EXPECT_NE(result.output.find("cannot write " + r.path + ": " + r.problem),
+              std::string::npos)
+        << result.output;
+  }
+  // Folders that do not exist yet are made on write.
+  const std::string absolute = dir + "/new/deeper/walk.json";
+  CommandResult result = RunMimic2d("clip from-motion " + walk +
+                                    " --views 1 --duration 1 -o " + absolute);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(absolute));
+  result = testing::RunCommand("cd " + dir + " && " + MIMIC2D_BINARY +
+                               " clip from-motion " + walk +
+                               " --views 1 --duration 1 -o zz/y.json");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir + "/zz/y.json"));
 }
 
 // Found by fuzzing: a document nested 50,000 deep crashed the reader
