@@ -337,10 +337,9 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
     episode_.failed = true;
     return outcome;
   }
-  if (frame_ >= view_->num_frames - 1 ||
-      episode_.steps >= options_.max_episode_steps()) {
-    outcome.truncated = true;
-  }
+  outcome.reference_ended = frame_ >= view_->num_frames - 1;
+  outcome.truncated =
+      outcome.reference_ended || episode_.steps >= options_.max_episode_steps();
   WriteObservation(observation);
   return outcome;
 }

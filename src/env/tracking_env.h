@@ -180,7 +180,10 @@ struct TrackingEnvOptions {
 struct StepOutcome {
   float reward = 0.0f;
   bool terminated = false;  // early exit or divergence: no bootstrap
-  bool truncated = false;   // time limit or end of reference: bootstrap
+  bool truncated = false;   // time limit or end of reference
+  // Truncated because the reference's last frame was reached: the task is
+  // over (nothing follows to track), unlike a time limit's cut.
+  bool reference_ended = false;
   bool diverged = false;
   ReprojectionError error;  // of the new frame
   RewardTerms terms;

@@ -27,6 +27,7 @@ VecEnv::VecEnv(std::shared_ptr<const Character> character,
   rewards_.assign(num_envs, 0.0f);
   terminated_.assign(num_envs, 0);
   truncated_.assign(num_envs, 0);
+  reference_ended_.assign(num_envs, 0);
   finished_flag_.assign(num_envs, 0);
   finished_stats_.resize(num_envs);
 }
@@ -75,6 +76,7 @@ void VecEnv::StepEnv(int i) {
   rewards_[i] = outcome.reward;
   terminated_[i] = outcome.terminated;
   truncated_[i] = outcome.truncated;
+  reference_ended_[i] = outcome.reference_ended;
   finished_flag_[i] = outcome.terminated || outcome.truncated;
   if (finished_flag_[i]) {
     if (outcome.truncated) {

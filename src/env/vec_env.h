@@ -42,6 +42,9 @@ class VecEnv {
   // Per env, set by the last Step(): 1 if the episode ended that way.
   const uint8_t* terminated() const { return terminated_.data(); }
   const uint8_t* truncated() const { return truncated_.data(); }
+  // Of the truncated: 1 if the reference's last frame was reached (rather
+  // than the time limit).
+  const uint8_t* reference_ended() const { return reference_ended_.data(); }
   // For truncated envs, the observation the episode ended in (before the
   // automatic reset), so the learner can bootstrap its value.
   const float* final_observations() const { return final_observations_.data(); }
@@ -73,7 +76,8 @@ class VecEnv {
   int action_size_ = 0;
   int num_threads_ = 1;
   std::vector<float> observations_, actions_, rewards_, final_observations_;
-  std::vector<uint8_t> terminated_, truncated_, finished_flag_;
+  std::vector<uint8_t> terminated_, truncated_, reference_ended_,
+      finished_flag_;
   std::vector<EpisodeStats> finished_stats_;
 };
 

@@ -196,18 +196,23 @@ void RolloutCollector::RecordStepOutcome(ActorCritic& policy, int begin,
   // rewards and dones: this step's [num_envs] rows of the storage.
   float* reward = rewards.data_ptr<float>();
   float* done = dones.data_ptr<float>();
-  std::vector<int64_t> truncated_rows;
+  // Outline: copy rewards and done flags; then the rows cut by a time limit
+  // (not failures) get gamma * V(last observation). A reference's end is
+  // bootstrapped only when the options say so.
+  std::vector<int64_t> bootstrapped_rows;
   for (int i = begin; i < end; ++i) {
     reward[i] = envs_.rewards()[i];
     done[i] = (envs_.terminated()[i] || envs_.truncated()[i]) ? 1.0f : 0.0f;
-    if (envs_.truncated()[i]) truncated_rows.push_back(i);
+    const bool bootstrap =
+        envs_.truncated()[i] &&
+        (options_.bootstrap_at_reference_end || !envs_.reference_ended()[i]);
+    if (bootstrap) bootstrapped_rows.push_back(i);
   }
-  if (truncated_rows.empty()) return;
-  // Time limits are not failures: bootstrap with V(last observation).
+  if (bootstrapped_rows.empty()) return;
   torch::Tensor final_raw =
       torch::from_blob(const_cast<float*>(envs_.final_observations()),
                        {envs_.num_envs(), envs_.observation_size()})
-          .index_select(0, torch::tensor(truncated_rows, torch::kLong));
+          .index_select(0, torch::tensor(bootstrapped_rows, torch::kLong));
   torch::Tensor final_value =
       policy
           ->Value(options_.normalize_observations ? policy->Normalize(final_raw)
@@ -215,8 +220,8 @@ void RolloutCollector::RecordStepOutcome(ActorCritic& policy, int begin,
           .to(torch::kFloat)
           .contiguous();
   const float* value = final_value.data_ptr<float>();
-  for (size_t r = 0; r < truncated_rows.size(); ++r) {
-    reward[truncated_rows[r]] +=
+  for (size_t r = 0; r < bootstrapped_rows.size(); ++r) {
+    reward[bootstrapped_rows[r]] +=
         static_cast<float>(options_.discount) * value[r];
   }
 }

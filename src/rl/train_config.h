@@ -179,6 +179,13 @@ struct PpoOptions {
   bool overlap_update = false;
   TrainingPrecision training_precision = TrainingPrecision::kFp32;
   CollectionMode collection = CollectionMode::kBatched;
+  // An episode cut by the time limit gets gamma * V(last observation) on
+  // its last reward; one that reached its reference's last frame has ended
+  // its task and gets nothing, unless this is set. That last observation is
+  // never a training sample (the env resets) and its future frames all
+  // repeat the last one, so V there is an extrapolation which, bootstrapped,
+  // can run away (docs/training.md, "The clip's end").
+  bool bootstrap_at_reference_end = false;
 
   // Every setting (common/settings.h): the config's `agent` section.
   template <typename Self, typename Visitor>
@@ -189,6 +196,10 @@ struct PpoOptions {
       "rollout horizon per iteration (batch = num_envs x steps_per_env)");
     v("discount", self.discount, Range::Open(0, 1), "gamma");
     v("gae_lambda", self.gae_lambda, Range::Closed(0, 1), "lambda of GAE");
+    v("bootstrap_at_reference_end", self.bootstrap_at_reference_end,
+      Range::Any(),
+      "add gamma * V(last observation) when an episode reaches its "
+      "reference's last frame, as at a time limit (false: the task ended)");
     v("clip_ratio", self.clip_ratio, Range::Above(0), "PPO surrogate clip");
     v("advantage_clip", self.advantage_clip, Range::Above(0),
       "clip of normalized advantages");

@@ -104,6 +104,7 @@ TEST(TrackingEnv, EpisodesAreTruncatedAtTheTimeLimitAndAtTheClipEnd) {
     ++steps;
   } while (!outcome.truncated && !outcome.terminated);
   EXPECT_TRUE(outcome.truncated);
+  EXPECT_FALSE(outcome.reference_ended);  // the time limit, not the clip
   EXPECT_EQ(steps, 15);
   int last = task.reference->views()[0].num_frames - 1;
   env.ResetTo(0, last - 3,
@@ -114,6 +115,8 @@ TEST(TrackingEnv, EpisodesAreTruncatedAtTheTimeLimitAndAtTheClipEnd) {
     outcome = env.Step(action.data(), obs.data());
     ++steps;
   } while (!outcome.truncated && !outcome.terminated);
+  EXPECT_TRUE(outcome.truncated);
+  EXPECT_TRUE(outcome.reference_ended);
   EXPECT_EQ(steps, 3);
 }
 

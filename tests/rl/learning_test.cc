@@ -23,11 +23,15 @@ namespace {
 // Calibrated on this machine (see the closing note of the learning issue).
 // Measured first: 200k samples in 117 s; frames tracked before the 100 px
 // early exit went from 10.2 (untrained) to 26.8 of 45, E2D from 26.4 to
-// 19.9 px. Measured 2026-11-24 (the environment and trainer as they are
-// now): 33 s, frames 10.6 -> 21.8, E2D 27.0 -> 21.4 px.
+// 19.9 px. Measured 2026-11-24: 33 s, frames 10.6 -> 21.8, E2D 27.0 ->
+// 21.4 px. Since 2026-12-01 a clip's end is not bootstrapped
+// (agent.bootstrap_at_reference_end; docs/training.md, "The clip's end"):
+// frames 10.6 -> 17.9, E2D 27.0 -> 20.8 px at this seed (7); seeds 8, 9,
+// 10 hold 24.2, 23.3, 20.3 frames (bootstrapped: 22.0, 24.2, 19.3, 26.6), so
+// the bounds sit below the lowest seed, not at one seed's figure.
 constexpr int64_t kTrainingSamples = 200'000;
-constexpr double kMinSurvivalGain = 1.6;    // measured 2.6x, now 2.06x
-constexpr double kMinTrainedFrames = 18.0;  // measured 26.8, now 21.8
+constexpr double kMinSurvivalGain = 1.45;   // measured 1.69x (seed 7)
+constexpr double kMinTrainedFrames = 15.5;  // measured 17.9-24.2 (seeds 7-10)
 
 // Small networks and batches so that it learns in CI time.
 void UseCiSizedLearning(const std::string& dir, TrainConfig* config) {
@@ -153,8 +157,9 @@ TEST(Learning, PpoCutsTheWalkTrackingErrorWithinMinutes) {
 // 18.3 (1.73x), E2D 27.0 -> 19.7 px, against 21.8 frames and 21.4 px
 // sequentially at the same 200k samples: each update starts one update
 // away from the policy that collected its batch, so the clip bites sooner.
-constexpr double kMinOverlapSurvivalGain = 1.4;  // measured 1.73x
-constexpr double kMinOverlapTrainedFrames = 15;  // measured 18.3
+// With a clip's end not bootstrapped (2026-12-01): 10.6 -> 16.3 frames.
+constexpr double kMinOverlapSurvivalGain = 1.3;  // measured 1.73x, now 1.54x
+constexpr double kMinOverlapTrainedFrames = 14;  // measured 18.3, now 16.3
 TEST(Learning, AnOverlappedUpdateLearnsTheWalk) {
   ExpectTheWalkIsLearned("learning_overlap", /*overlap_update=*/true,
                          TrainingPrecision::kFp32,
@@ -165,9 +170,10 @@ TEST(Learning, AnOverlappedUpdateLearnsTheWalk) {
 // (agent.training_precision: bf16). Measured 2026-11-24: frames 10.6 ->
 // 20.8 (1.96x), E2D 27.0 -> 18.5 px, against 21.8 frames and 21.4 px in
 // float32 at the same 200k samples and seed; with ASI's critic also in
-// bfloat16, 25.4 frames and 20.0 px.
-constexpr double kMinBf16SurvivalGain = 1.6;    // measured 1.96x, 2.40x
-constexpr double kMinBf16TrainedFrames = 18.0;  // measured 20.8, 25.4
+// bfloat16, 25.4 frames and 20.0 px; with a clip's end not bootstrapped
+// (2026-12-01, an Intel Xeon without bf16 units: 831 s), 22.5 frames.
+constexpr double kMinBf16SurvivalGain = 1.6;    // measured 1.96x, 2.40x, 2.12x
+constexpr double kMinBf16TrainedFrames = 18.0;  // measured 20.8, 25.4, 22.5
 TEST(Learning, ABf16UpdateLearnsTheWalk) {
   ExpectTheWalkIsLearned("learning_bf16", /*overlap_update=*/false,
                          TrainingPrecision::kBf16,
@@ -178,16 +184,18 @@ TEST(Learning, ABf16UpdateLearnsTheWalk) {
 // env thread acts for its own 16 environments, and the observation
 // normalizer takes in a rollout's observations after it. Measured
 // 2026-11-24: frames 10.6 -> 23.9 (2.25x), E2D 27.0 -> 22.5 px, against
-// 21.8 frames and 21.4 px batched at the same seed and samples.
-constexpr double kMinPerThreadSurvivalGain = 1.6;    // measured 2.25x
-constexpr double kMinPerThreadTrainedFrames = 18.0;  // measured 23.9
+// 21.8 frames and 21.4 px batched at the same seed and samples; with a
+// clip's end not bootstrapped (2026-12-01), 21.9 frames, E2D 20.4 px.
+constexpr double kMinPerThreadSurvivalGain = 1.6;    // measured 2.25x, 2.07x
+constexpr double kMinPerThreadTrainedFrames = 18.0;  // measured 23.9, 21.9
 // The 3D-supervised baseline's task (env.target: body_3d): the same walk,
 // followed in 3D from its truth with a DeepMimic-style reward, judged by
 // the same 2D evaluation as the 2D tracker. Measured 2026-11-27 at the same
 // seed and samples (51 s with a training on the other core), joints compared
 // as rotations: frames tracked before the 100 px exit 10.6 -> 30.0 (2.8x),
 // E2D 27.1 -> 30.9 px over those longer rollouts (hinge angles, 2026-11-24:
-// 10.5 -> 22.9).
+// 10.5 -> 22.9); with a clip's end not bootstrapped (2026-12-01), 10.6 ->
+// 23.5 frames (2.2x).
 TEST(Learning, A3dTrackerLearnsTheWalkFromItsTruth) {
   ExpectTheWalkIsLearned("learning_3d", /*overlap_update=*/false,
                          TrainingPrecision::kFp32,
@@ -248,8 +256,10 @@ std::shared_ptr<const Character> UseCharacter(
 // the early exit 10.7 -> 14.3 of 45, E2D 30.6 -> 19.8 px. Less than from
 // 3D truth: the fit keeps the walker's travel out of its following cameras
 // (docs/fit.md, "Known limits"), so the starts ask for a walk in place.
-constexpr double kMin2dSurvivalGain = 1.15;  // measured 1.34x
-constexpr double kMax2dErrorRatio = 0.85;    // measured 0.65
+// With a clip's end not bootstrapped (2026-12-01): 10.9 -> 18.7 frames,
+// E2D 28.7 -> 21.2 px.
+constexpr double kMin2dSurvivalGain = 1.15;  // measured 1.34x, now 1.72x
+constexpr double kMax2dErrorRatio = 0.85;    // measured 0.65, now 0.74
 
 TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
   const std::string walk_path =
@@ -284,9 +294,11 @@ TEST(Learning, PpoLearnsTheWalkFromAStrippedAndFittedBundle) {
 // training): 200k samples gave frames 3.3 -> 3.8, too faint to test; 400k
 // (142 s) gives 3.3 -> 5.2 frames before the 100 px exit, E2D 24.6 -> 23.0
 // px over those longer rollouts, so only the survival is asserted (as for
-// the 3D tracker above).
+// the 3D tracker above). With a clip's end not bootstrapped (2026-12-01;
+// the dog's 2-s clips end often, docs/training.md "The clip's end"): 3.3
+// -> 6.2 frames, E2D 24.6 -> 23.1 px.
 constexpr int64_t kDogTrainingSamples = 400'000;
-constexpr double kMinDogSurvivalGain = 1.3;  // measured 1.58x
+constexpr double kMinDogSurvivalGain = 1.3;  // measured 1.58x, now 1.88x
 
 TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
   std::string dir = testing::TempDir("learning_dog");
@@ -325,8 +337,9 @@ TEST(Learning, PpoLearnsTheDogsTrotFromAStrippedAndFittedBundle) {
 // lives past the kick (frame 11), where the untrained one had fallen
 // before the ball moved, so the two average different frames. Whether the
 // ball follows its reference is the long training's measure (docs/ball.md).
+// With a clip's end not bootstrapped (2026-12-01): 15.2 -> 27.5 frames.
 constexpr int64_t kBallTrainingSamples = 200'000;
-constexpr double kMinBallSurvivalGain = 1.3;  // measured 1.72x
+constexpr double kMinBallSurvivalGain = 1.3;  // measured 1.72x, now 1.81x
 
 // What a user of the ball has: 2 s of the walk with a ball kicked along,
 // seen by 2 static views as 2D (the walker's keypoints and the ball's
@@ -375,7 +388,8 @@ TEST(Learning, PpoLearnsToWalkAndKickTheBallFromAStrippedAndFittedBundle) {
 // training; 89 s): frames before the 100 px exit 15.2 -> 25.3, E2D 29.6 ->
 // 31.8 px and EO2D 43 -> 78 px over those longer rollouts (as the 2D
 // tracker's above), so only the survival is asserted.
-constexpr double kMinBallSfvSurvivalGain = 1.3;  // measured 1.66x
+// With a clip's end not bootstrapped (2026-12-01): 15.2 -> 28.3 frames.
+constexpr double kMinBallSfvSurvivalGain = 1.3;  // measured 1.66x, now 1.86x
 
 TEST(Learning, TheTwoStageBaselineLearnsToWalkWithTheBallFromTheFitsThreeD) {
   std::string dir = testing::TempDir("learning_ball_sfv");
