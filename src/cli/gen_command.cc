@@ -89,19 +89,20 @@ int RunGenTrain(const GenTrainArgs& args) {
       std::printf(
           "tokenizer %7lld/%lld | loss %.4f (canonical %.4f absolute %.4f "
           "velocity %.4f commit %.4f) | perplexity %6.1f, %3d codes used, %3d "
-          "reset | lr %.1e | %.1f steps/s | ETA %.0f s\n",
+          "reset | lr %.1e | %.1f steps/s, %d threads | ETA %.0f s\n",
           static_cast<long long>(p.step), static_cast<long long>(p.steps),
           p.loss, p.canonical_loss, p.absolute_loss, p.velocity_loss,
           p.commit_loss, p.perplexity, p.used_codes, p.reset_codes,
-          p.learning_rate, p.step / std::max(1e-9, p.seconds), eta_s);
+          p.learning_rate, p.step / std::max(1e-9, p.seconds), p.torch_threads,
+          eta_s);
     } else {
       std::printf(
           "prior     %7lld/%lld | cross-entropy %.4f nats (held out %.4f) | "
-          "next-code accuracy %5.1f%% | lr %.1e | %.1f steps/s | ETA %.0f "
-          "s\n",
+          "next-code accuracy %5.1f%% | lr %.1e | %.1f steps/s, %d threads "
+          "| ETA %.0f s\n",
           static_cast<long long>(p.step), static_cast<long long>(p.steps),
           p.loss, p.validation_loss, 100.0 * p.accuracy, p.learning_rate,
-          p.step / std::max(1e-9, p.seconds), eta_s);
+          p.step / std::max(1e-9, p.seconds), p.torch_threads, eta_s);
     }
     std::fflush(stdout);
   };

@@ -38,6 +38,10 @@ void GenConfig::Validate() const {
   prior.Validate();
   CheckRanges(run, "run");
   if (run.run_dir.empty()) throw ConfigError("run.run_dir is empty");
+  if (run.adapt_torch_threads && run.torch_threads < 2)
+    throw ConfigError(
+        "run.adapt_torch_threads needs run.torch_threads >= 2 (it probes 1 "
+        "thread against torch_threads)");
 }
 
 namespace {

@@ -193,6 +193,10 @@ struct GenRunOptions {
   uint64_t seed = 1;
   double checkpoint_minutes = 5.0;
   int torch_threads = 2;
+  // Probe 1 thread against torch_threads while training and keep the
+  // faster (rl/speed_tuner.h), as the PPO trainer's agent setting does: two
+  // threads collapse when another process competes for the cores.
+  bool adapt_torch_threads = false;
 
   template <typename Self, typename Visitor>
   static void VisitFields(Self& self, Visitor& v) {
@@ -203,6 +207,9 @@ struct GenRunOptions {
       "minutes between checkpoints");
     v("torch_threads", self.torch_threads, Range::Closed(1, 256),
       "LibTorch threads");
+    v("adapt_torch_threads", self.adapt_torch_threads, Range::Any(),
+      "probe 1 thread against torch_threads while training and keep the "
+      "faster (re-probed as the load changes; needs torch_threads >= 2)");
   }
 };
 

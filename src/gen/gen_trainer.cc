@@ -14,9 +14,11 @@
 
 #include "common/error.h"
 #include "common/file_io.h"
+#include "common/pauses.h"
 #include "gen/gen_checkpoint.h"
 #include "gen/gpt.h"
 #include "gen/vqvae.h"
+#include "rl/speed_tuner.h"
 
 namespace m2d {
 
@@ -196,6 +198,42 @@ struct StageContext {
   }
 };
 
+// LibTorch's thread count, step by step: run.torch_threads, or with
+// run.adapt_torch_threads the faster of it and 1 thread as a SpeedTuner
+// measures them (probes now and then, more often after a slowdown).
+class StepThreads {
+ public:
+  explicit StepThreads(const GenRunOptions& run)
+      : configured_(run.torch_threads) {
+    if (run.adapt_torch_threads && configured_ >= 2)
+      tuner_ = std::make_unique<SpeedTuner>(SpeedTunerOptions());
+  }
+  // Before a step: the threads it runs with, and its clock started.
+  void Begin() {
+    candidate_ = tuner_ ? tuner_->CandidateForNextIteration() : 0;
+    torch::set_num_threads(Threads(candidate_));
+    started_ = Clock::now();
+    mark_ = MarkPauses();
+  }
+  // After it: its time to the tuner, unless a pause of the process or the
+  // machine's sleep falls inside (common/pauses.h).
+  void End() {
+    if (!tuner_ || PausedBetween(mark_, MarkPauses())) return;
+    tuner_->Record(candidate_, SecondsSince(started_));
+  }
+  // The chosen setting's threads (what the steps run with between probes).
+  int chosen_threads() const { return Threads(tuner_ ? tuner_->chosen() : 0); }
+
+ private:
+  int Threads(int candidate) const { return candidate == 0 ? configured_ : 1; }
+
+  int configured_;
+  std::unique_ptr<SpeedTuner> tuner_;
+  int candidate_ = 0;
+  Clock::time_point started_;
+  PauseMark mark_;
+};
+
 // The loop both stages share: until `steps` or a stop, the scheduled rate,
 // one `step()`, a report when due (`report` fills the stage's figures into
 // the progress and returns its log row), a checkpoint (`save`) when due and
@@ -216,15 +254,19 @@ double RunStage(const StageContext& context, GenStage stage, int64_t steps,
     state->seconds = clock.seconds();
     save();
   };
+  StepThreads threads(context.config.run);
   while (state->step < steps && !context.stop_requested()) {
     const double rate = ScheduledRate(base_rate, state->step, steps);
     SetRate(optimizer, rate);
+    threads.Begin();
     step();
+    threads.End();
     progress.step = ++state->step;
     if (StageContext::ReportDue(progress, clock)) {
       clock.last_report = Clock::now();
       progress.seconds = clock.seconds();
       progress.learning_rate = rate;
+      progress.torch_threads = threads.chosen_threads();
       log.Append(report(&progress));
       if (context.on_progress) context.on_progress(progress);
     }

@@ -25,6 +25,7 @@ struct GenProgress {
   int64_t steps = 0;     // the stage's total
   double seconds = 0.0;  // this stage's training time so far
   double learning_rate = 0.0;
+  int torch_threads = 0;  // LibTorch's threads for the steps now
   double loss = 0.0;  // tokenizer: the total loss; prior: cross-entropy (nats)
   // Tokenizer: reconstruction terms and codebook use.
   double canonical_loss = 0.0, absolute_loss = 0.0, velocity_loss = 0.0,

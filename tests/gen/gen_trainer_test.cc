@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "common/error.h"
 #include "common/file_io.h"
@@ -93,6 +94,37 @@ TEST(GenTrainer, AResumedRunEndsWhereAnUninterruptedOneDoes) {
       ReadFileText(stopped.run.run_dir + "/tokenizer_log.csv");
   EXPECT_EQ(log.find("\n1,"), log.rfind("\n1,"));
   EXPECT_NE(log.find("\n6,"), std::string::npos);
+}
+
+// run.adapt_torch_threads: the steps run with torch_threads or 1 thread as
+// a SpeedTuner measures them, every report says which, and the stages
+// finish as without it; the setting needs torch_threads >= 2.
+TEST(GenTrainer, AdaptiveThreadsReportWhatTheStepsRunWith) {
+  GenConfig config = TinyConfig(TempRun("adaptive_threads"));
+  config.run.torch_threads = 2;
+  config.run.adapt_torch_threads = true;
+  config.tokenizer.steps = 12;  // past the tuner's first probe (4 steps)
+  config.Validate();
+  std::vector<int> reported;
+  const GenTrainSummary summary = TrainGenerator(
+      config, WalkDataset(), false, nullptr,
+      [&](const GenProgress& p) { reported.push_back(p.torch_threads); });
+  EXPECT_FALSE(summary.interrupted);
+  EXPECT_EQ(summary.tokenizer_steps, 12);
+  EXPECT_EQ(summary.prior_steps, 4);
+  ASSERT_FALSE(reported.empty());
+  for (int threads : reported) EXPECT_TRUE(threads == 1 || threads == 2);
+  // Without the setting the configured count is reported.
+  reported.clear();
+  config.run.adapt_torch_threads = false;
+  config.run.run_dir = TempRun("fixed_threads");
+  TrainGenerator(
+      config, WalkDataset(), false, nullptr,
+      [&](const GenProgress& p) { reported.push_back(p.torch_threads); });
+  for (int threads : reported) EXPECT_EQ(threads, 2);
+  config.run.torch_threads = 1;
+  config.run.adapt_torch_threads = true;
+  EXPECT_THROW(config.Validate(), ConfigError);
 }
 
 // The prior's held-out tail (the last context of codes of every long
