@@ -96,24 +96,27 @@ EndCounts CollectEnds(const std::string& walk_path,
   return counts;
 }
 
+// Time-limit ends always carry gamma * V; clip ends only with the setting.
+void ExpectEndsBootstrapped(bool bootstrap_at_reference_end,
+                            CollectionMode collection) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  EndCounts counts = CollectEnds(path, bootstrap_at_reference_end, collection);
+  ASSERT_GE(counts.time_limit, 5);
+  ASSERT_GE(counts.reference_end, 2);
+  EXPECT_EQ(counts.time_limit_bootstrapped, counts.time_limit);
+  EXPECT_EQ(counts.reference_end_bootstrapped,
+            bootstrap_at_reference_end ? counts.reference_end : 0);
+}
+
 class Collector : public ::testing::TestWithParam<CollectionMode> {};
 
 TEST_P(Collector, TheReferencesEndAddsNoValueByDefault) {
-  M2D_REQUIRE_SHARED(path, kWalk);
-  EndCounts counts = CollectEnds(path, false, GetParam());
-  ASSERT_GE(counts.time_limit, 5);
-  ASSERT_GE(counts.reference_end, 2);
-  EXPECT_EQ(counts.time_limit_bootstrapped, counts.time_limit);
-  EXPECT_EQ(counts.reference_end_bootstrapped, 0);
+  ExpectEndsBootstrapped(PpoOptions().bootstrap_at_reference_end, GetParam());
+  EXPECT_FALSE(PpoOptions().bootstrap_at_reference_end);
 }
 
 TEST_P(Collector, BootstrapAtReferenceEndAddsTheValueAsATimeLimitDoes) {
-  M2D_REQUIRE_SHARED(path, kWalk);
-  EndCounts counts = CollectEnds(path, true, GetParam());
-  ASSERT_GE(counts.time_limit, 5);
-  ASSERT_GE(counts.reference_end, 2);
-  EXPECT_EQ(counts.time_limit_bootstrapped, counts.time_limit);
-  EXPECT_EQ(counts.reference_end_bootstrapped, counts.reference_end);
+  ExpectEndsBootstrapped(true, GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(BothCollections, Collector,
