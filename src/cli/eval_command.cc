@@ -15,6 +15,7 @@ struct EvalArgs {
   std::vector<std::string> bundles;
   std::vector<std::string> truth_bundles;  // measurement only, per bundle
   std::string output;
+  std::string frames_output;  // --frames: per-frame CSV
   EvalOptions options;
   std::string starts;   // "": the checkpoint's config
   std::string cameras;  // "": the checkpoint's config
@@ -30,6 +31,7 @@ int RunEval(const EvalArgs& args) {
   sources.checkpoint_buffers = args.asi_starts;
   EvalOptions options = args.options;
   ParseSetting(args.success_measure, &options.success_measure);  // checked
+  options.record_frames = !args.frames_output.empty();
   CheckpointEvaluation evaluation = EvaluateCheckpoint(
       args.checkpoint, args.bundles, options, sources, args.truth_bundles);
   std::printf(
@@ -56,6 +58,10 @@ int RunEval(const EvalArgs& args) {
   if (!args.output.empty()) {
     WriteEvalJson(args.output, args.checkpoint, options, evaluation);
     std::printf("wrote %s\n", args.output.c_str());
+  }
+  if (!args.frames_output.empty()) {
+    WriteEvalFramesCsv(args.frames_output, evaluation);
+    std::printf("wrote %s (per-frame errors)\n", args.frames_output.c_str());
   }
   return 0;
 }
@@ -132,6 +138,12 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
                    "Seed of the push directions and object offsets")
       ->capture_default_str();
   eval->add_option("-o,--output", args->output, "Write the table as JSON here")
+      ->check(WritableFile());
+  eval->add_option("--frames", args->frames_output,
+                   "Write every rollout's per-frame errors here as CSV (mean "
+                   "and worst keypoint in px, which keypoint, PA-MPJPE with "
+                   "truth, how the rollout ended): where a rollout starts "
+                   "to fail")
       ->check(WritableFile());
   eval->callback([run, args] { *run = [args] { return RunEval(*args); }; });
 }

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/error.h"
 #include "common/file_io.h"
@@ -57,6 +61,59 @@ void PrintRow(const EvalRow& row, int view_width) {
       Cell(row.e3d_pa_mm, "%.0f").c_str(), Cell(row.jitter, "%.2f").c_str());
 }
 
+// The K views' names of a row ("a+b" -> {"a", "b"}).
+std::vector<std::string> SplitViewNames(const std::string& joined) {
+  std::vector<std::string> names(1);
+  for (char c : joined) {
+    if (c == '+') {
+      names.emplace_back();
+    } else {
+      names.back() += c;
+    }
+  }
+  return names;
+}
+
+// A keypoint's name, "" for none (-1).
+std::string KeypointName(const CheckpointEvaluation& evaluation, int index) {
+  if (index < 0 || index >= static_cast<int>(evaluation.keypoint_names.size()))
+    return "";
+  return evaluation.keypoint_names[index];
+}
+
+// "ended: 12 early_exit (worst keypoint then: left_wrist 5, ...), 28
+// clip_end": how the rollouts ended, and which keypoints failed the early
+// exits, most frequent first.
+void PrintRolloutEnds(const CheckpointEvaluation& evaluation) {
+  std::map<RolloutEnd, int> ends;
+  std::map<std::string, int> exit_keypoints;
+  for (const EvalRow& row : evaluation.rows) {
+    for (const EvalRollout& rollout : row.rollouts) {
+      ++ends[rollout.end];
+      if (rollout.end == RolloutEnd::kEarlyExit)
+        ++exit_keypoints[KeypointName(evaluation, rollout.last_worst_keypoint)];
+    }
+  }
+  std::vector<std::pair<int, std::string>> by_count;
+  for (const auto& [name, count] : exit_keypoints)
+    by_count.push_back({-count, name.empty() ? "none" : name});
+  std::sort(by_count.begin(), by_count.end());
+  std::string line = "rollouts ended:";
+  const char* separator = " ";
+  for (const auto& [end, count] : ends) {
+    line += separator + std::to_string(count) + " " + RolloutEndName(end);
+    separator = ", ";
+    if (end != RolloutEnd::kEarlyExit) continue;
+    line += " (worst keypoint then:";
+    for (size_t i = 0; i < by_count.size(); ++i) {
+      line += (i ? ", " : " ") + by_count[i].second + " " +
+              std::to_string(-by_count[i].first);
+    }
+    line += ")";
+  }
+  std::printf("%s\n", line.c_str());
+}
+
 nlohmann::json RowToJson(const EvalRow& row) {
   auto optional = [](double v) {
     return v < 0 ? nlohmann::json() : nlohmann::json(v);
@@ -78,7 +135,8 @@ nlohmann::json RowToJson(const EvalRow& row) {
       json["rollouts"].push_back({{"start_frame", rollout.start_frame},
                                   {"frames", rollout.frames},
                                   {"succeeded", rollout.succeeded},
-                                  {"e2d_px", rollout.e2d_px}});
+                                  {"e2d_px", rollout.e2d_px},
+                                  {"end", RolloutEndName(rollout.end)}});
     }
   }
   return json;
@@ -144,6 +202,7 @@ CheckpointEvaluation EvaluateCheckpoint(
     }
     truth.push_back(truth_bundle.ground_truth);
   }
+  evaluation.keypoint_names = task.character->keypoint_layout().keypoint_names;
   evaluation.rows =
       EvaluatePolicy(policy, task.character, task.reference,
                      task.initial_states, config.env, options, truth);
@@ -171,6 +230,35 @@ void PrintEvalTable(const CheckpointEvaluation& evaluation) {
               "EO2D(px)", "E3D(mm)", "E3Droot(mm)", "E3DPA(mm)", "Jitter");
   for (const EvalRow& row : evaluation.rows) PrintRow(row, view_width);
   PrintRow(AggregateRows(evaluation.rows), view_width);
+  PrintRolloutEnds(evaluation);
+}
+
+void WriteEvalFramesCsv(const std::string& path,
+                        const CheckpointEvaluation& evaluation) {
+  std::string csv =
+      "clip,view,rollout,start_frame,step,frame,keypoints_present,mean_px,"
+      "worst_px,worst_keypoint,worst_view,pa_mm,end\n";
+  char numbers[160];
+  for (const EvalRow& row : evaluation.rows) {
+    const std::vector<std::string> views = SplitViewNames(row.view);
+    for (size_t r = 0; r < row.rollouts.size(); ++r) {
+      const EvalRollout& rollout = row.rollouts[r];
+      for (size_t step = 0; step < rollout.trace.size(); ++step) {
+        const EvalFrame& frame = rollout.trace[step];
+        std::snprintf(numbers, sizeof(numbers), "%zu,%d,%zu,%d,%d,%.2f,%.2f,",
+                      r, rollout.start_frame, step + 1, frame.frame,
+                      frame.keypoints_present, frame.mean_px, frame.worst_px);
+        csv += row.bundle + "," + row.view + "," + numbers +
+               KeypointName(evaluation, frame.worst_keypoint) + "," +
+               views[std::min<size_t>(frame.worst_view, views.size() - 1)] +
+               "," + (frame.pa_mm < 0 ? "" : Cell(frame.pa_mm, "%.1f")) + "," +
+               (step + 1 == rollout.trace.size() ? RolloutEndName(rollout.end)
+                                                 : "") +
+               "\n";
+      }
+    }
+  }
+  WriteFileAtomic(path, csv);
 }
 
 void WriteEvalJson(const std::string& path, const std::string& checkpoint,

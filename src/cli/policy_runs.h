@@ -34,6 +34,7 @@ struct SourceOverrides {
 struct CheckpointEvaluation {
   TaskSources sources;              // the ones the rollouts used
   bool checkpoint_buffers = false;  // starts from the checkpoint's buffers
+  std::vector<std::string> keypoint_names;  // the character's, by index
   std::vector<EvalRow> rows;
 };
 
@@ -49,13 +50,22 @@ CheckpointEvaluation EvaluateCheckpoint(
     const std::vector<std::string>& truth_paths = {});
 
 // A header naming the sources, one line per row, then the episode-weighted
-// "all" row.
+// "all" row, then how the rollouts ended (and on which keypoints the early
+// exits failed).
 void PrintEvalTable(const CheckpointEvaluation& evaluation);
 
 // Writes the sources, rows + "all" as JSON, atomically.
 void WriteEvalJson(const std::string& path, const std::string& checkpoint,
                    const EvalOptions& options,
                    const CheckpointEvaluation& evaluation);
+
+// Writes every rollout's per-frame errors (EvalOptions::record_frames) as
+// CSV, one line per simulated step, atomically: clip, view, rollout,
+// start_frame, step, frame, keypoints_present, mean_px, worst_px,
+// worst_keypoint (its name), worst_view, pa_mm (empty without truth), end
+// (on a rollout's last step: early_exit, diverged, clip_end or time_limit).
+void WriteEvalFramesCsv(const std::string& path,
+                        const CheckpointEvaluation& evaluation);
 
 // Rolls the checkpoint's policy out on `replay.view` of `bundle` from
 // `start_frame` for at most `episode_s`, and draws it as `replay` says.

@@ -28,7 +28,10 @@ ReprojectionError MeasureReprojection(const double* projected_xy_px,
     }
     error.weighted_sum_px += target.confidence * distance_px;
     sum_px += distance_px;
-    error.max_px = std::max(error.max_px, distance_px);
+    if (error.worst_keypoint < 0 || distance_px > error.max_px) {
+      error.max_px = distance_px;
+      error.worst_keypoint = j;
+    }
     ++error.num_present;
   }
   error.mean_px = error.num_present > 0 ? sum_px / error.num_present : 0.0;
@@ -61,7 +64,12 @@ ReprojectionError CombineViewErrors(const ReprojectionError* errors,
   ReprojectionError combined;
   int measured_views = 0;  // a view without keypoints this frame has no mean
   for (int k = 0; k < num_views; ++k) {
-    combined.max_px = std::max(combined.max_px, errors[k].max_px);
+    if (errors[k].max_px > combined.max_px ||
+        (combined.worst_keypoint < 0 && errors[k].worst_keypoint >= 0)) {
+      combined.max_px = errors[k].max_px;
+      combined.worst_keypoint = errors[k].worst_keypoint;
+      combined.worst_view = k;
+    }
     combined.num_present += errors[k].num_present;
     combined.any_behind_camera |= errors[k].any_behind_camera;
     if (errors[k].num_present == 0) continue;

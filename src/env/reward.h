@@ -40,6 +40,8 @@ struct ReprojectionError {
   double weighted_sum_px = 0.0;    // sum_j c_j |P(x_j) - x^_j| over present j
   double mean_px = 0.0;            // unweighted mean over present j
   double max_px = 0.0;             // worst present keypoint
+  int worst_keypoint = -1;         // its index (-1: none present)
+  int worst_view = 0;              // of K views combined, the one it is in
   int num_present = 0;             // reference keypoints that count
   bool any_behind_camera = false;  // a counted keypoint projects behind
 };
@@ -95,9 +97,9 @@ RewardTerms ComputeReward(const ReprojectionError& pose_error,
                           const RewardWeights& weights);
 
 // One frame's errors in K views of the same motion, as one: the worst
-// keypoint of any view; the sums and means averaged over the views that
-// had keypoints; the present counts summed; behind the camera in any. K = 1
-// returns the error itself.
+// keypoint of any view (and which view); the sums and means averaged over the
+// views that had keypoints; the present counts summed; behind the camera in
+// any. K = 1 returns the error itself.
 ReprojectionError CombineViewErrors(const ReprojectionError* errors,
                                     int num_views);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "common/error.h"
 #include "eval/metrics.h"
@@ -34,7 +35,28 @@ std::vector<std::vector<int>> ViewSets(const TrackingReference& reference,
   return sets;
 }
 
+RolloutEnd EndOf(const StepOutcome& outcome) {
+  if (outcome.diverged) return RolloutEnd::kDiverged;
+  if (outcome.terminated) return RolloutEnd::kEarlyExit;
+  return outcome.reference_ended ? RolloutEnd::kClipEnd
+                                 : RolloutEnd::kTimeLimit;
+}
+
 }  // namespace
+
+const char* RolloutEndName(RolloutEnd end) {
+  switch (end) {
+    case RolloutEnd::kEarlyExit:
+      return "early_exit";
+    case RolloutEnd::kDiverged:
+      return "diverged";
+    case RolloutEnd::kClipEnd:
+      return "clip_end";
+    case RolloutEnd::kTimeLimit:
+      return "time_limit";
+  }
+  return "?";
+}
 
 void EvalOptions::Validate() const {
   if (episodes_per_view < 1)
@@ -153,13 +175,32 @@ std::vector<EvalRow> EvaluatePolicy(
       KeypointFrames simulated, true_keypoints;
       double object_error = 0.0;
       int object_frames = 0;
+      std::vector<EvalFrame> trace;
+      StepOutcome outcome;
       for (;;) {
         policy.Act(observation.data(), 1, action.data());
-        StepOutcome outcome = env.Step(action.data(), observation.data());
+        outcome = env.Step(action.data(), observation.data());
         if (!outcome.diverged) {
           simulated.push_back(SimulatedKeypoints(env.simulation()));
           if (has_truth)
             true_keypoints.push_back(bundle_truth->keypoints_m[env.frame()]);
+        }
+        if (options.record_frames) {
+          EvalFrame record;
+          record.frame = env.frame();
+          if (!outcome.diverged) {
+            record.keypoints_present = outcome.error.num_present;
+            record.mean_px = outcome.error.mean_px;
+            record.worst_px = outcome.error.max_px;
+            record.worst_keypoint = outcome.error.worst_keypoint;
+            record.worst_view = outcome.error.worst_view;
+            if (has_truth) {
+              record.pa_mm =
+                  1000.0 * ProcrustesAlignedError({simulated.back()},
+                                                  {true_keypoints.back()});
+            }
+          }
+          trace.push_back(record);
         }
         if (reference->num_object_points() > 0 && !outcome.diverged) {
           const int num_keypoints = layout.num_keypoints();
@@ -188,7 +229,9 @@ std::vector<EvalRow> EvaluatePolicy(
                              2 * stats.measured_steps >= stats.steps &&
                              stats.measured_steps > 0;
       row.rollouts.push_back(
-          {start, stats.steps, succeeded, stats.mean_error_px()});
+          {start, stats.steps, succeeded, stats.mean_error_px(), EndOf(outcome),
+           outcome.diverged ? -1 : outcome.error.worst_keypoint,
+           std::move(trace)});
       succ += succeeded ? 1.0 : 0.0;
       frames += stats.steps;
       if (stats.measured_steps > 0) {

@@ -39,7 +39,31 @@ struct EvalOptions {
   PushOptions pushes;
   double object_start_square_m = 0.0;
   uint64_t perturbation_seed = 1;
+  // Keep every rollout's per-frame errors (EvalRollout::trace; eval
+  // --frames): where and on which keypoint a rollout starts to fail.
+  bool record_frames = false;
   void Validate() const;  // throws ConfigError
+};
+
+// What ended a rollout.
+enum class RolloutEnd {
+  kEarlyExit,  // a frame over the success threshold (or behind a camera)
+  kDiverged,   // the simulation became unstable
+  kClipEnd,    // the reference's last frame
+  kTimeLimit,  // episode_s
+};
+const char* RolloutEndName(RolloutEnd end);  // "early_exit", ...
+
+// One simulated frame of a rollout, as the success rule judged it.
+struct EvalFrame {
+  int frame = 0;              // the reference frame the step reached
+  int keypoints_present = 0;  // reference keypoints compared (all K views)
+  double mean_px = 0.0;       // mean keypoint error (K views: their mean)
+  double worst_px = 0.0;      // the worst keypoint's error
+  int worst_keypoint = -1;    // its index in the character's layout (-1:
+                              // none present, or the step diverged)
+  int worst_view = 0;         // of the K views, the one it is in
+  double pa_mm = -1.0;        // this frame's PA-MPJPE (-1: no truth)
 };
 
 // One evaluation rollout (to find which start fails).
@@ -48,6 +72,10 @@ struct EvalRollout {
   int frames = 0;  // until the first failing frame or the end
   bool succeeded = false;
   double e2d_px = 0.0;
+  RolloutEnd end = RolloutEnd::kClipEnd;
+  int last_worst_keypoint = -1;  // the last step's worst keypoint (the one
+                                 // that failed it, for an early exit)
+  std::vector<EvalFrame> trace;  // per step, with record_frames only
 };
 
 struct EvalRow {

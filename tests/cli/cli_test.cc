@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -378,13 +379,54 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
   // The stripped-and-fitted file measured against the original's truth
   // (--truth) gives the same figures: the rollouts never read it.
   const std::string stripped_json = dir + "/eval_stripped.json";
+  const std::string frames_csv = dir + "/frames/eval_frames.csv";
   result = RunMimic2d("eval " + policy + " --bundle " + fitted_path +
                       " --truth " + full +
                       " --starts estimate --cameras estimate --episodes 1 "
                       "--episode-s 0.3 -o " +
-                      stripped_json);
+                      stripped_json + " --frames " + frames_csv);
   ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("rollouts ended: "), std::string::npos)
+      << result.output;
   nlohmann::json measured = ReadJsonFile(stripped_json);
+  // --frames: one CSV line per simulated step of every rollout, the worst
+  // keypoint named, PA-MPJPE from the hidden truth, the end on the last.
+  {
+    std::ifstream csv(frames_csv);
+    std::string line;
+    ASSERT_TRUE(std::getline(csv, line)) << frames_csv;
+    EXPECT_EQ(line,
+              "clip,view,rollout,start_frame,step,frame,keypoints_present,"
+              "mean_px,worst_px,worst_keypoint,worst_view,pa_mm,end");
+    int lines = 0, ends = 0;
+    while (std::getline(csv, line)) {
+      ++lines;
+      std::vector<std::string> cells;
+      std::istringstream fields(line + ",");
+      for (std::string cell; std::getline(fields, cell, ',');)
+        cells.push_back(cell);
+      ASSERT_EQ(cells.size(), 13u) << line;
+      EXPECT_EQ(cells[0], fitted.name) << line;
+      EXPECT_EQ(cells[9].find_first_not_of("abcdefghijklmnopqrstuvwxyz_"),
+                std::string::npos)
+          << line;
+      EXPECT_FALSE(cells[9].empty()) << line;
+      EXPECT_EQ(cells[10], cells[1]) << line;  // one view at a time
+      EXPECT_GT(std::stod(cells[11]), 0.0) << line;
+      if (!cells[12].empty()) ++ends;
+    }
+    int frames = 0, rollouts = 0;
+    for (const auto& row : measured["rows"]) {
+      for (const auto& rollout : row["rollouts"]) {
+        frames += rollout["frames"].get<int>();
+        ++rollouts;
+        EXPECT_TRUE(rollout["end"].is_string());
+      }
+    }
+    EXPECT_EQ(lines, frames);
+    EXPECT_EQ(ends, rollouts);
+    EXPECT_EQ(rollouts, 3);
+  }
   ASSERT_TRUE(measured["all"]["e3d_root_mm"].is_number());
   EXPECT_DOUBLE_EQ(measured["all"]["e3d_root_mm"].get<double>(),
                    eval["all"]["e3d_root_mm"].get<double>());

@@ -20,7 +20,16 @@ TEST(Reprojection, SumsConfidenceWeightedDistancesOverPresentKeypoints) {
   EXPECT_DOUBLE_EQ(error.weighted_sum_px, 5.0);
   EXPECT_DOUBLE_EQ(error.mean_px, 2.5);
   EXPECT_DOUBLE_EQ(error.max_px, 5.0);
+  EXPECT_EQ(error.worst_keypoint, 0);
   EXPECT_FALSE(error.any_behind_camera);
+  // The worst is the farthest present keypoint, wherever it is.
+  const Keypoint2D far_second[] = {{3, 4, 1.0}, {10, 9, 0.5}, {0, 0, 0.0}};
+  EXPECT_EQ(
+      MeasureReprojection(projected, in_front, far_second, 3).worst_keypoint,
+      1);
+  const Keypoint2D none[] = {{0, 0, 0.0}, {0, 0, 0.0}, {0, 0, 0.0}};
+  EXPECT_EQ(MeasureReprojection(projected, in_front, none, 3).worst_keypoint,
+            -1);
 }
 
 TEST(Reprojection, NanReferenceIsMissingAndBehindCameraIsPenalized) {
@@ -111,12 +120,15 @@ TEST(Reprojection, ViewsCombineWorstOfMaxAndMeanOfMeans) {
   errors[1].mean_px = 20;
   errors[1].weighted_sum_px = 340;
   errors[1].max_px = 120;
+  errors[1].worst_keypoint = 9;
   errors[1].num_present = 17;
   errors[2].num_present = 0;  // no keypoints in this view this frame
   ReprojectionError combined = CombineViewErrors(errors, 3);
   EXPECT_DOUBLE_EQ(combined.mean_px, 15.0);
   EXPECT_DOUBLE_EQ(combined.weighted_sum_px, 255.0);
   EXPECT_DOUBLE_EQ(combined.max_px, 120.0);
+  EXPECT_EQ(combined.worst_keypoint, 9);  // the worst keypoint's view's
+  EXPECT_EQ(combined.worst_view, 1);
   EXPECT_EQ(combined.num_present, 34);
   EXPECT_TRUE(ShouldExitEarly(combined, 100.0));
   ReprojectionError single = CombineViewErrors(errors, 1);

@@ -31,6 +31,15 @@ EvalOptions RunToLength(int episodes_per_view, double episode_s) {
   return options;
 }
 
+// Two rollouts of at most 3 s (90 frames at 30 Hz) per view, judged by
+// the 100-px default: the standing character fails the walk in each.
+EvalOptions TwoShortRollouts() {
+  EvalOptions options;
+  options.episodes_per_view = 2;
+  options.episode_s = 3.0;
+  return options;
+}
+
 // `task`'s walk evaluated with its 3D truth.
 std::vector<EvalRow> EvaluateWalk(Policy& policy, const testing::WalkTask& task,
                                   const EvalOptions& options) {
@@ -43,12 +52,8 @@ TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
   ZeroPolicy policy = MakeZeroPolicy(task);
-  EvalOptions options;
-  options.episodes_per_view = 2;
-  options.episode_s = 3.0;  // 90 frames at 30 Hz
-  std::vector<EvalRow> rows = EvaluatePolicy(
-      policy, task.character, task.reference, task.initial_states, task.options,
-      options, {task.reference->bundles()[0].ground_truth});
+  const EvalOptions options = TwoShortRollouts();
+  std::vector<EvalRow> rows = EvaluateWalk(policy, task, options);
 
   const int episode_frames = 90;
   ASSERT_EQ(rows.size(), task.reference->views().size());
@@ -89,6 +94,56 @@ TEST(EvaluatePolicy, AStandingPolicyFailsToTrackTheWalk) {
   EXPECT_EQ(all.succ, 0.0);
 }
 
+TEST(EvaluatePolicy, RecordedFramesShowWhereAndOnWhichKeypointRolloutsFail) {
+  M2D_REQUIRE_SHARED(path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
+  ZeroPolicy policy = MakeZeroPolicy(task);
+  EvalOptions options = TwoShortRollouts();
+  const std::vector<EvalRow> plain = EvaluateWalk(policy, task, options);
+  options.record_frames = true;
+  const std::vector<EvalRow> rows = EvaluateWalk(policy, task, options);
+  ASSERT_EQ(rows.size(), plain.size());
+  for (size_t r = 0; r < rows.size(); ++r) {
+    SCOPED_TRACE(rows[r].view);
+    // Recording changes nothing measured.
+    EXPECT_DOUBLE_EQ(rows[r].e2d_px, plain[r].e2d_px);
+    EXPECT_DOUBLE_EQ(rows[r].e3d_pa_mm, plain[r].e3d_pa_mm);
+    for (size_t e = 0; e < rows[r].rollouts.size(); ++e) {
+      const EvalRollout& rollout = rows[r].rollouts[e];
+      EXPECT_TRUE(plain[r].rollouts[e].trace.empty());
+      EXPECT_EQ(plain[r].rollouts[e].end, rollout.end);
+      // One record per step, of consecutive reference frames; the standing
+      // character fails the walk by early exit at the last one, and only
+      // there is a keypoint off by more than the threshold.
+      ASSERT_EQ(static_cast<int>(rollout.trace.size()), rollout.frames);
+      EXPECT_EQ(rollout.end, RolloutEnd::kEarlyExit);
+      double sum_mean_px = 0;
+      for (size_t k = 0; k < rollout.trace.size(); ++k) {
+        const EvalFrame& frame = rollout.trace[k];
+        EXPECT_EQ(frame.frame, rollout.start_frame + static_cast<int>(k) + 1);
+        EXPECT_EQ(frame.keypoints_present, 17);
+        EXPECT_LE(frame.mean_px, frame.worst_px);
+        EXPECT_GE(frame.worst_keypoint, 0);
+        EXPECT_LT(frame.worst_keypoint, 17);
+        EXPECT_GT(frame.pa_mm, 0.0);  // with the truth
+        EXPECT_EQ(frame.worst_px > options.success_threshold_px,
+                  k + 1 == rollout.trace.size());
+        sum_mean_px += frame.mean_px;
+      }
+      EXPECT_NEAR(sum_mean_px / rollout.frames, rollout.e2d_px, 1e-9);
+      EXPECT_EQ(rollout.last_worst_keypoint,
+                rollout.trace.back().worst_keypoint);
+    }
+  }
+  // A rollout no frame can fail, longer than the clip, ends at its end.
+  for (const EvalRow& row : EvaluateWalk(policy, task, RunToLength(1, 10.0))) {
+    ASSERT_EQ(row.rollouts.size(), 1u);
+    EXPECT_EQ(row.rollouts[0].end, RolloutEnd::kClipEnd);
+    EXPECT_EQ(row.rollouts[0].frames,
+              task.reference->bundles()[0].num_frames() - 1);
+  }
+}
+
 TEST(EvaluatePolicy, TheMeanKeypointRuleFailsNoRolloutEarlier) {
   // A frame's mean error never exceeds its worst keypoint's, so judged by
   // the mean every rollout lasts at least as long; the standing character
@@ -98,9 +153,7 @@ TEST(EvaluatePolicy, TheMeanKeypointRuleFailsNoRolloutEarlier) {
   testing::WalkTask task = testing::MakeWalkTask(path, 4.0);
   ZeroPolicy policy = MakeZeroPolicy(task);
   auto rows_by = [&](FrameErrorMeasure measure) {
-    EvalOptions options;
-    options.episodes_per_view = 2;
-    options.episode_s = 3.0;
+    EvalOptions options = TwoShortRollouts();
     options.success_measure = measure;
     return EvaluatePolicy(policy, task.character, task.reference,
                           task.initial_states, task.options, options);
@@ -142,6 +195,10 @@ TEST(EvaluatePolicy, AGenerousThresholdLetsEveryEpisodeRunItsLength) {
       EXPECT_EQ(row.rollouts[e].start_frame, starts[e]);
       EXPECT_EQ(row.rollouts[e].frames, 15);
       EXPECT_TRUE(row.rollouts[e].succeeded);
+      // The last start's episode ends on the clip's last frame: the clip's
+      // end, which also ends the task.
+      EXPECT_EQ(row.rollouts[e].end,
+                e < 2 ? RolloutEnd::kTimeLimit : RolloutEnd::kClipEnd);
     }
   }
   // The policy ignores what it observes, so every view rolls out the same
