@@ -18,7 +18,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-runs/ball}
-bin=build/mimic2d
+# shellcheck source=scripts/private_binary.sh
+source scripts/private_binary.sh
+private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 mkdir -p "$out"
 
 if [ ! -f "$out/walk_2d.json" ]; then

@@ -30,7 +30,9 @@ if [ -n "${2:-}" ]; then
 fi
 shared=${MIMIC2D_SHARED_DATA:-../shared/data}
 motions="$shared/deepmimic/motions"
-bin=build/mimic2d
+# shellcheck source=scripts/private_binary.sh
+source scripts/private_binary.sh
+private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 mkdir -p "$out"
 
 train_clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"

@@ -20,7 +20,9 @@ cd "$(dirname "$0")/.."
 out=${1:-runs/dog}
 shared=${MIMIC2D_SHARED_DATA:-../shared/data}
 motions="$shared/deepmimic/motions"
-bin=build/mimic2d
+# shellcheck source=scripts/private_binary.sh
+source scripts/private_binary.sh
+private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 character=characters/dog.yaml
 mkdir -p "$out"
 

@@ -14,7 +14,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-runs/walk24}
-bin=build/mimic2d
+# shellcheck source=scripts/private_binary.sh
+source scripts/private_binary.sh
+private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 mkdir -p "$out"
 for el in 10 5 15; do
   if [ ! -f "$out/el${el}_2d.json" ]; then

@@ -19,7 +19,9 @@ out=${1:-runs/walks}
 shift || true
 shared=${MIMIC2D_SHARED_DATA:-../shared/data}
 long="$shared/deepmimic/motions/long"
-bin=build/mimic2d
+# shellcheck source=scripts/private_binary.sh
+source scripts/private_binary.sh
+private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 mkdir -p "$out"
 walks=("$@")
 if [ ${#walks[@]} -eq 0 ]; then
