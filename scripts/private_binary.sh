@@ -4,7 +4,8 @@
 # run the binary for minutes; rebuilding the project meanwhile rewrites
 # build/mimic2d, and the steps started after that failed with "Permission
 # denied" (seen 2026-12-02 while make_dataset.sh ran beside a build).
-# A missing build is named, exit 1.
+# A missing build is named, exit 1. It takes the script's EXIT trap: a
+# script with its own removes "$bin" there too.
 
 private_binary() {
   if [ ! -x build/mimic2d ]; then
