@@ -13,10 +13,12 @@
 #include "cli/motion_source.h"
 #include "common/error.h"
 #include "common/file_io.h"
+#include "eval/motion_feasibility.h"
 #include "motion/bundle.h"
 #include "motion/clip_io.h"
 #include "sim/character.h"
 #include "sim/object_replay.h"
+#include "sim/simulation.h"
 
 namespace m2d::cli {
 namespace {
@@ -202,6 +204,144 @@ int RunInfo(const std::string& path) {
   return 0;
 }
 
+struct FeasibilityArgs {
+  std::string input;
+  std::string poses = "truth";  // truth | estimate
+  std::string character = "characters/humanoid.yaml";
+  std::string frames_csv;
+  int opening_frames = 10;
+  std::string torque_limit = "servo";
+  FeasibilityOptions options;
+};
+
+// One row of the feasibility table: a set of poses and what they take.
+struct FeasibilityRow {
+  std::string name;
+  MotionFeasibility result;
+};
+
+void PrintFeasibilityTable(const std::vector<FeasibilityRow>& rows,
+                           const Character& character, int opening_frames) {
+  std::printf("%-10s %6s %12s %14s %9s %14s %8s  %s\n", "poses", "frames",
+              "over torque", "floor cannot", "airborne", "flight force",
+              "opening", "worst hinge (peak / limit, frames over)");
+  for (const FeasibilityRow& row : rows) {
+    const MotionFeasibility& r = row.result;
+    double opening_ratio = 0.0;
+    for (int t = 0; t < std::min(opening_frames, r.num_frames); ++t) {
+      opening_ratio = std::max(opening_ratio, r.frames[t].worst_torque_ratio);
+    }
+    const HingeDemand* worst = nullptr;
+    for (const HingeDemand& hinge : r.hinges) {
+      if (hinge.frames_measured == 0) continue;
+      if (!worst ||
+          hinge.peak_nm / hinge.limit_nm > worst->peak_nm / worst->limit_nm) {
+        worst = &hinge;
+      }
+    }
+    char worst_text[128] = "-";
+    if (worst) {
+      std::snprintf(worst_text, sizeof(worst_text), "%s %.2f, %d of %d",
+                    worst->actuator.c_str(), worst->peak_nm / worst->limit_nm,
+                    worst->frames_over_limit, worst->frames_measured);
+    }
+    std::printf("%-10s %6d %11.1f%% %13.1f%% %9d %11.2f bw %8.2f  %s\n",
+                row.name.c_str(), r.num_frames,
+                100.0 * r.FramesOverTorqueLimit() / r.num_frames,
+                100.0 * r.FramesFloorCannotExplain() / r.num_frames,
+                r.AirborneFrames(), r.MeanForceInFlightBodyWeights(),
+                opening_ratio, worst_text);
+  }
+  std::printf(
+      "over torque: frames in which a hinge the floor cannot reach needs more "
+      "than its limit; floor cannot: a force needed in flight, a pull or a "
+      "slip; flight force: mean external force while airborne, in %s's "
+      "body weights; opening: the worst torque / limit over the first %d "
+      "frames\n",
+      character.name().c_str(), opening_frames);
+}
+
+void WriteFeasibilityFramesCsv(const std::string& path,
+                               const std::vector<FeasibilityRow>& rows) {
+  std::string csv =
+      "poses,frame,touching,worst_torque_ratio,worst_hinge,force_x_n,"
+      "force_y_n,force_z_n,force_in_flight,pulls_floor,slips\n";
+  char line[256];
+  for (const FeasibilityRow& row : rows) {
+    const MotionFeasibility& r = row.result;
+    for (int t = 0; t < r.num_frames; ++t) {
+      const FrameDemand& f = r.frames[t];
+      std::snprintf(
+          line, sizeof(line), "%s,%d,%d,%.3f,%s,%.1f,%.1f,%.1f,%d,%d,%d\n",
+          row.name.c_str(), t, f.touching ? 1 : 0, f.worst_torque_ratio,
+          f.worst_hinge < 0 ? "" : r.hinges[f.worst_hinge].actuator.c_str(),
+          f.external_force_n.x(), f.external_force_n.y(),
+          f.external_force_n.z(), f.force_in_flight ? 1 : 0,
+          f.pulls_floor ? 1 : 0, f.slips ? 1 : 0);
+      csv += line;
+    }
+  }
+  WriteFileAtomic(path, csv);
+}
+
+int RunFeasibility(const FeasibilityArgs& args) {
+  // Outline: the bundle's truth or each view's fitted poses, checked against
+  // the character's skeleton; the inverse dynamics of each; a table.
+  FeasibilityOptions options = args.options;
+  ParseSetting(args.torque_limit, &options.torque_limit);
+  options.Validate();
+  const ReferenceBundle bundle = ReadBundle(args.input);
+  auto character = Character::Load(AssetArgumentPath(args.character), "flat",
+                                   SimulationOptions().physics_timestep_s());
+  const std::string& skeleton = character->skeleton().name;
+  std::vector<FeasibilityRow> rows;
+  const auto add_row = [&](const std::string& name,
+                           const std::string& pose_skeleton,
+                           const std::vector<Pose3D>& poses) {
+    if (poses.empty()) {
+      throw InputError(args.input, name + " has no 3D poses to measure");
+    }
+    if (pose_skeleton != skeleton) {
+      throw InputError(args.input,
+                       name + "'s poses are of skeleton '" + pose_skeleton +
+                           "', the character's is '" + skeleton + "'");
+    }
+    rows.push_back({name, MeasureMotionFeasibility(*character, poses,
+                                                   bundle.fps, options)});
+  };
+  if (args.poses == "truth") {
+    if (!bundle.ground_truth) {
+      throw InputError(args.input,
+                       "has no 3D ground truth (--poses estimate measures a "
+                       "fit's poses)");
+    }
+    add_row("truth", bundle.ground_truth->skeleton_name,
+            bundle.ground_truth->poses);
+  } else {
+    if (!bundle.estimate) {
+      throw InputError(args.input,
+                       "has no estimate: fit it first (mimic2d fit)");
+    }
+    for (size_t v = 0; v < bundle.estimate->size(); ++v) {
+      const ViewEstimate& estimate = (*bundle.estimate)[v];
+      add_row(bundle.views[v].name, estimate.skeleton_name, estimate.poses);
+    }
+  }
+  std::printf(
+      "feasibility of %s (%s poses) for %s, torque_limit %s: "
+      "contact within %.3f m of the floor, friction %.2f, force "
+      "tolerance %.2f body weights\n",
+      args.input.c_str(), args.poses.c_str(), character->name().c_str(),
+      SettingName(options.torque_limit), options.contact_height_m,
+      options.friction_coefficient, options.force_tolerance_body_weights);
+  PrintFeasibilityTable(rows, *character, args.opening_frames);
+  if (!args.frames_csv.empty()) {
+    WriteFeasibilityFramesCsv(args.frames_csv, rows);
+    std::printf("wrote %s\n", args.frames_csv.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 void AddClipCommand(CLI::App& app, CommandRun* run) {
@@ -281,6 +421,48 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
       ->capture_default_str();
   resample_cmd->callback([run, resample] {
     *run = [resample] { return RunResample(*resample); };
+  });
+
+  auto feasibility = std::make_shared<FeasibilityArgs>();
+  CLI::App* feasibility_cmd = clip->add_subcommand(
+      "feasibility",
+      "Whether a bundle's 3D poses (the truth, or each view's fit) are "
+      "physically possible for the character: the torques and the floor's "
+      "push that following them exactly takes (inverse dynamics)");
+  feasibility_cmd->add_option("bundle", feasibility->input, "Bundle JSON")
+      ->required();
+  feasibility_cmd
+      ->add_option("--poses", feasibility->poses,
+                   "truth (the bundle's 3D ground truth) or estimate (each "
+                   "view's fitted poses)")
+      ->check(CLI::IsMember({"truth", "estimate"}))
+      ->capture_default_str();
+  feasibility_cmd
+      ->add_option("--character", feasibility->character,
+                   "character config (relative to assets/ unless absolute)")
+      ->capture_default_str();
+  feasibility_cmd
+      ->add_option("--frames", feasibility->frames_csv,
+                   "Also write every frame's worst hinge and external force "
+                   "(CSV)")
+      ->check(WritableFile());
+  feasibility_cmd
+      ->add_option("--opening", feasibility->opening_frames,
+                   "Frames counted as the clip's opening in the table")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  feasibility_cmd
+      ->add_option("--contact-height", feasibility->options.contact_height_m,
+                   "A body this close to the floor may touch it (m)")
+      ->capture_default_str();
+  feasibility_cmd
+      ->add_option("--torque-limit", feasibility->torque_limit,
+                   "what the torque limits bound: servo (the damping on top, "
+                   "as env.torque_limit: servo trains) or pd (the whole PD)")
+      ->check(CLI::IsMember({"servo", "pd"}))
+      ->capture_default_str();
+  feasibility_cmd->callback([run, feasibility] {
+    *run = [feasibility] { return RunFeasibility(*feasibility); };
   });
 
   auto info_path = std::make_shared<std::string>();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "common/error.h"
@@ -357,6 +358,18 @@ void Character::BindActuators() {
       throw InputError(model_path_,
                        std::string("actuator of hinge '") + hinge_name +
                            "' must be a <position> servo (kp > 0, gear 1)");
+    }
+    hinge.kp_nm_per_rad = kp;
+    hinge.kd_nm_s_per_rad = m->dof_damping[hinge.dof_address];
+    const bool limited = m->actuator_forcelimited[a];
+    const double infinity = std::numeric_limits<double>::infinity();
+    hinge.torque_low_nm = limited ? m->actuator_forcerange[2 * a] : -infinity;
+    hinge.torque_high_nm =
+        limited ? m->actuator_forcerange[2 * a + 1] : infinity;
+    if (!(hinge.torque_low_nm < 0.0 && hinge.torque_high_nm > 0.0)) {
+      throw InputError(model_path_, std::string("actuator of hinge '") +
+                                        hinge_name +
+                                        "' needs a forcerange around 0");
     }
   }
 }

@@ -59,6 +59,12 @@ struct ActuatedHinge {
   double range_high_rad = 0.0;
   double target_mid_rad = 0.0;         // centre of the joint range
   double target_half_range_rad = 0.0;  // half width x action_range_scale
+  // The PD's gains and limit, as the MJCF holds them: the servo's kp, the
+  // joint's damping (kd) and the actuator's forcerange.
+  double kp_nm_per_rad = 0.0;
+  double kd_nm_s_per_rad = 0.0;
+  double torque_low_nm = 0.0;   // most negative torque (forcerange[0])
+  double torque_high_nm = 0.0;  // most positive torque (forcerange[1])
 };
 
 // How one skeleton joint is realized in the model.

@@ -104,6 +104,7 @@ Simulation::Simulation(std::shared_ptr<const Character> character,
     }
   }
   hinge_qvel_.assign(character_->num_actions(), 0.0);
+  targets_rad_.assign(character_->num_actions(), 0.0);
   mean_torques_.assign(character_->num_actions(), 0.0);
   allowed_ground_.assign(m->nbody, 0);
   for (int body : character_->ground_contact_bodies())
@@ -133,9 +134,10 @@ StepResult Simulation::Step(const float* normalized_actions) {
   const std::vector<ActuatedHinge>& hinges = character_->hinges();
   const int num_hinges = static_cast<int>(hinges.size());
   for (int i = 0; i < num_hinges; ++i) {
-    d->ctrl[hinges[i].actuator_id] =
-        TargetFor(hinges[i], normalized_actions[i]);
+    targets_rad_[i] = TargetFor(hinges[i], normalized_actions[i]);
+    d->ctrl[hinges[i].actuator_id] = targets_rad_[i];
   }
+  const bool limit_whole_pd = options_.torque_limit == TorqueLimit::kPd;
   std::fill(mean_torques_.begin(), mean_torques_.end(), 0.0);
   double power_sum = 0.0;
   int substeps_done = 0;
@@ -148,11 +150,14 @@ StepResult Simulation::Step(const float* normalized_actions) {
       for (int i = 0; i < num_hinges; ++i) {
         hinge_qvel_[i] = d->qvel[hinges[i].dof_address];
       }
+      if (limit_whole_pd) LimitWholePd(targets_rad_.data());
       mj_step2(m, d);
-      // The forces mj_step2 used: servo (clamped) plus joint damping.
+      // The forces mj_step2 used: servo (clamped) plus joint damping, plus
+      // the damping's cancellation where the whole PD is at its limit.
       for (int i = 0; i < num_hinges; ++i) {
         const int dof = hinges[i].dof_address;
-        const double torque = d->qfrc_actuator[dof] + d->qfrc_passive[dof];
+        const double torque = d->qfrc_actuator[dof] + d->qfrc_passive[dof] +
+                              (limit_whole_pd ? d->qfrc_applied[dof] : 0.0);
         mean_torques_[i] += torque;
         power_sum += std::abs(hinge_qvel_[i] * torque);
       }
@@ -171,6 +176,40 @@ StepResult Simulation::Step(const float* normalized_actions) {
   }
   result.divergence = divergence_;
   return result;
+}
+
+void Simulation::LimitWholePd(const double* targets_rad) {
+  // Per hinge, the PD torque u = kp (q* - q) - kd qdot. The joint's damping
+  // (-kd qdot, integrated implicitly: stable at any rate) stays as it is;
+  // the servo and an applied torque make up the rest:
+  // - u within the limit: the servo's kp (q* - q), plus what its own clamp
+  //   cut off (nothing, unless the joint is fast and the target far);
+  // - u beyond it: the servo at the limit and kd qdot, cancelling the
+  //   damping, so that the joint gets the limit itself, as from a
+  //   torque-limited PD (DeepMimic). The implicit damping still weighs the
+  //   step's velocity change, as if the joint were h kd heavier then.
+  mjData* d = data_.get();
+  const std::vector<ActuatedHinge>& hinges = character_->hinges();
+  for (size_t i = 0; i < hinges.size(); ++i) {
+    const ActuatedHinge& hinge = hinges[i];
+    const double q = d->qpos[hinge.qpos_address];
+    const double qdot = d->qvel[hinge.dof_address];
+    const double servo_nm = hinge.kp_nm_per_rad * (targets_rad[i] - q);
+    const double pd_nm = servo_nm - hinge.kd_nm_s_per_rad * qdot;
+    double* ctrl = d->ctrl + hinge.actuator_id;
+    double* applied = d->qfrc_applied + hinge.dof_address;
+    if (pd_nm > hinge.torque_high_nm || pd_nm < hinge.torque_low_nm) {
+      // Twice the limit's distance: the servo clamps at exactly the limit.
+      const double limit_nm =
+          pd_nm > 0.0 ? hinge.torque_high_nm : hinge.torque_low_nm;
+      *ctrl = q + 2.0 * limit_nm / hinge.kp_nm_per_rad;
+      *applied = hinge.kd_nm_s_per_rad * qdot;
+    } else {
+      *ctrl = targets_rad[i];
+      *applied = servo_nm - std::clamp(servo_nm, hinge.torque_low_nm,
+                                       hinge.torque_high_nm);
+    }
+  }
 }
 
 void Simulation::CheckDivergence(const int* warnings_before) {
@@ -339,6 +378,33 @@ std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation) {
   return points;
 }
 
+double LowestGeomPointZ(const mjModel* m, const mjData* d, int g) {
+  const double* size = m->geom_size + 3 * g;
+  // Row 2 of the geom's rotation: the world z of its local axes.
+  const double* z_of_axis = d->geom_xmat + 9 * g + 6;
+  const double axis_z = std::abs(z_of_axis[2]);
+  double reach_m = m->geom_rbound[g];
+  switch (m->geom_type[g]) {
+    case mjGEOM_SPHERE:
+      reach_m = size[0];
+      break;
+    case mjGEOM_CAPSULE:
+      reach_m = size[0] + size[1] * axis_z;
+      break;
+    case mjGEOM_CYLINDER:
+      reach_m = size[0] * std::sqrt(std::max(0.0, 1.0 - axis_z * axis_z)) +
+                size[1] * axis_z;
+      break;
+    case mjGEOM_BOX:
+      reach_m = size[0] * std::abs(z_of_axis[0]) +
+                size[1] * std::abs(z_of_axis[1]) + size[2] * axis_z;
+      break;
+    default:
+      break;
+  }
+  return d->geom_xpos[3 * g + 2] - reach_m;
+}
+
 double LowestCharacterPointZ(const Simulation& simulation) {
   const mjModel* m = simulation.model();
   const mjData* d = simulation.data();
@@ -346,30 +412,7 @@ double LowestCharacterPointZ(const Simulation& simulation) {
   for (int g = 0; g < m->ngeom; ++g) {
     if (!simulation.character().IsCharacterBody(m->geom_bodyid[g])) continue;
     if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) continue;
-    const double* size = m->geom_size + 3 * g;
-    // Row 2 of the geom's rotation: the world z of its local axes.
-    const double* z_of_axis = d->geom_xmat + 9 * g + 6;
-    const double axis_z = std::abs(z_of_axis[2]);
-    double reach_m = m->geom_rbound[g];
-    switch (m->geom_type[g]) {
-      case mjGEOM_SPHERE:
-        reach_m = size[0];
-        break;
-      case mjGEOM_CAPSULE:
-        reach_m = size[0] + size[1] * axis_z;
-        break;
-      case mjGEOM_CYLINDER:
-        reach_m = size[0] * std::sqrt(std::max(0.0, 1.0 - axis_z * axis_z)) +
-                  size[1] * axis_z;
-        break;
-      case mjGEOM_BOX:
-        reach_m = size[0] * std::abs(z_of_axis[0]) +
-                  size[1] * std::abs(z_of_axis[1]) + size[2] * axis_z;
-        break;
-      default:
-        break;
-    }
-    lowest_m = std::min(lowest_m, d->geom_xpos[3 * g + 2] - reach_m);
+    lowest_m = std::min(lowest_m, LowestGeomPointZ(m, d, g));
   }
   return lowest_m;
 }

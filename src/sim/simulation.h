@@ -15,6 +15,26 @@
 
 namespace m2d {
 
+// What a hinge's torque limit (its actuator's forcerange) bounds
+// (docs/simulation.md, "What the torque limit bounds").
+enum class TorqueLimit {
+  // The servo's kp (q* - q) alone; the joint's damping -kd qdot acts on top,
+  // unbounded. A joint then cannot be driven much faster than limit / kd
+  // (2-2.5 rad/s at the humanoid's shoulders, elbows and ankles).
+  kServo,
+  // The whole PD torque kp (q* - q) - kd qdot, as DeepMimic's torque limit
+  // and Isaac Gym's drive effort do: fast limbs stay within reach.
+  kPd,
+};
+inline const char* SettingName(TorqueLimit limit) {
+  return limit == TorqueLimit::kServo ? "servo" : "pd";
+}
+inline bool ParseSetting(const std::string& text, TorqueLimit* limit) {
+  return ParseSettingByName(text, {TorqueLimit::kServo, TorqueLimit::kPd},
+                            limit);
+}
+inline std::string SettingChoices(TorqueLimit) { return "servo, pd"; }
+
 struct SimulationOptions {
   double control_hz = 30.0;  // policy rate: one Step() per control period
   // Physics steps per control period (physics at control_hz x substeps).
@@ -27,6 +47,9 @@ struct SimulationOptions {
   double max_joint_speed_rad_s = 200.0;   // character rotational DoF
   double max_linear_speed_m_s = 50.0;     // every free body's translation
   double max_object_spin_rad_s = 1000.0;  // non-character free bodies
+  // What the torque limits bound; servo is how every policy before
+  // 2026-12-02 was trained.
+  TorqueLimit torque_limit = TorqueLimit::kServo;
 
   // Every setting (common/settings.h); a training config's `env` section.
   template <typename Self, typename Visitor>
@@ -44,6 +67,10 @@ struct SimulationOptions {
       "divergence limit on every free body's translation");
     v("max_object_spin_rad_s", self.max_object_spin_rad_s, Range::Above(0),
       "divergence limit on non-character free bodies' spin");
+    v("torque_limit", self.torque_limit, Range::Any(),
+      "what the actuators' torque limits bound: servo (kp (q* - q) alone, "
+      "joint damping on top, unbounded) or pd (the whole kp (q* - q) - kd "
+      "qdot, as DeepMimic)");
   }
 
   double physics_timestep_s() const {
@@ -145,7 +172,12 @@ class Simulation {
   SimulationOptions options_;
   MujocoDataPtr data_;
   Divergence divergence_ = Divergence::kNone;
-  std::vector<double> speed_limit_;      // per DoF
+  std::vector<double> speed_limit_;  // per DoF
+  // TorqueLimit::kPd: sets each hinge's servo target and applied torque
+  // for the next substep so that the PD's whole torque keeps to its limit.
+  void LimitWholePd(const double* targets_rad);
+
+  std::vector<double> targets_rad_;      // per action: the step's PD targets
   std::vector<double> hinge_qvel_;       // scratch: qvel before a substep
   std::vector<double> mean_torques_;     // per action
   std::vector<uint8_t> allowed_ground_;  // per body
@@ -155,6 +187,8 @@ class Simulation {
 // state: exact for spheres, capsules, cylinders and boxes, a bounding sphere
 // for other shapes.
 double LowestCharacterPointZ(const Simulation& simulation);
+// The same for geom `g` of `m` placed as in `d` (after kinematics).
+double LowestGeomPointZ(const mjModel* m, const mjData* d, int g);
 
 // The keypoint sites' world positions as points (layout order).
 std::vector<Eigen::Vector3d> SimulatedKeypoints(const Simulation& simulation);

@@ -287,6 +287,87 @@ TEST(Cli, AKickedBallIsSimulatedProjectedAndFitted) {
 
 // `clip strip` leaves what a user with videos has: the 2D, no truth, no
 // cameras, no estimate; `clip info` says so.
+// The cells of the row named `name` in a `clip feasibility` table.
+std::vector<std::string> FeasibilityRow(const std::string& output,
+                                        const std::string& name) {
+  std::istringstream lines(output);
+  std::string line;
+  while (std::getline(lines, line)) {
+    std::istringstream cells(line);
+    std::vector<std::string> row;
+    for (std::string cell; cells >> cell;) row.push_back(cell);
+    if (!row.empty() && row[0] == name) return row;
+  }
+  return {};
+}
+
+// `clip feasibility` on the repository's walk: the truth within the PD
+// limits and past the servo limits in some frames; each view's estimate
+// (the truth turned and moved: the same motion) reads as the truth does;
+// every frame in the CSV; named errors for a bundle without an estimate
+// and for another character's skeleton.
+TEST(Cli, ClipFeasibilityMeasuresTheTruthAndEachViewsFit) {
+  const std::string dir = testing::TempDir("cli_feasibility");
+  const std::string walk = dir + "/walk.json";
+  CommandResult made = RunMimic2d(
+      "clip from-motion " +
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+      " --views 2 --duration 2 -o " + walk);
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+
+  const std::string csv = dir + "/frames.csv";
+  CommandResult pd = RunMimic2d("clip feasibility " + walk +
+                                " --torque-limit pd --frames " + csv);
+  ASSERT_EQ(pd.exit_code, 0) << pd.output;
+  const std::vector<std::string> pd_truth = FeasibilityRow(pd.output, "truth");
+  ASSERT_GE(pd_truth.size(), 7u) << pd.output;
+  EXPECT_EQ(pd_truth[2], "0.0%") << pd.output;  // over a torque limit
+  CommandResult servo = RunMimic2d("clip feasibility " + walk);
+  ASSERT_EQ(servo.exit_code, 0) << servo.output;
+  const std::vector<std::string> servo_truth =
+      FeasibilityRow(servo.output, "truth");
+  ASSERT_GE(servo_truth.size(), 7u) << servo.output;
+  EXPECT_GT(std::stod(servo_truth[2]), 5.0) << servo.output;
+
+  const ReferenceBundle bundle = ReadBundle(walk);
+  std::ifstream frames(csv);
+  std::string line;
+  int lines = 0;
+  std::getline(frames, line);
+  EXPECT_EQ(line.rfind("poses,frame,touching,worst_torque_ratio", 0), 0u);
+  while (std::getline(frames, line)) ++lines;
+  EXPECT_EQ(lines, bundle.num_frames());
+
+  CommandResult no_estimate =
+      RunMimic2d("clip feasibility " + walk + " --poses estimate");
+  EXPECT_NE(no_estimate.exit_code, 0);
+  EXPECT_NE(no_estimate.output.find("has no estimate"), std::string::npos)
+      << no_estimate.output;
+
+  ReferenceBundle fitted = bundle;
+  fitted.estimate =
+      testing::EstimateFromTruth(bundle, {{0.0, {0, 0, 0}}, {1.2, {3, -1, 0}}});
+  const std::string fitted_path = dir + "/fitted.json";
+  WriteBundle(fitted_path, fitted);
+  CommandResult views =
+      RunMimic2d("clip feasibility " + fitted_path + " --poses estimate");
+  ASSERT_EQ(views.exit_code, 0) << views.output;
+  for (const ReferenceView& view : bundle.views) {
+    const std::vector<std::string> row =
+        FeasibilityRow(views.output, view.name);
+    ASSERT_GE(row.size(), 7u) << views.output;
+    for (int cell = 1; cell <= 6; ++cell) {
+      EXPECT_EQ(row[cell], servo_truth[cell]) << view.name << " " << cell;
+    }
+  }
+
+  CommandResult dog = RunMimic2d("clip feasibility " + walk +
+                                 " --character characters/dog.yaml");
+  EXPECT_NE(dog.exit_code, 0);
+  EXPECT_NE(dog.output.find("poses are of skeleton"), std::string::npos)
+      << dog.output;
+}
+
 TEST(Cli, ClipStripKeepsOnlyThe2D) {
   const std::string dir = testing::TempDir("cli_strip");
   auto skeleton = std::make_shared<const Skeleton>(

@@ -78,8 +78,15 @@ TEST(SimulationTest, ZeroActionRollout10kStepsNeverProducesNan) {
 }
 
 TEST(SimulationTest, RandomActionRollout10kStepsNeverProducesNan) {
-  for (const char* scene : {"flat", "ball"}) {
-    Simulation sim(LoadHumanoid(scene), SimulationOptions());
+  for (const char* scene : {"flat", "ball", "flat pd"}) {
+    SimulationOptions options;
+    if (std::string(scene) == "flat pd")
+      options.torque_limit = TorqueLimit::kPd;
+    Simulation sim(
+        LoadHumanoid(
+            std::string(scene).substr(0, 4) == "ball" ? "ball" : "flat",
+            options),
+        options);
     std::mt19937 rng(2024);
     std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
     const RolloutCounts counts =
@@ -160,9 +167,11 @@ TEST(SimulationTest, PdHoldsTheDogStandingOnTheFloor) {
 // Random step changes of the PD targets (0.4 rad around standing) converge
 // without oscillation at every substep count, even one (30 Hz physics).
 TEST(SimulationTest, StepResponseConvergesAtEverySubstepCount) {
-  for (int substeps = 1; substeps <= 6; ++substeps) {
+  for (int run = 0; run < 12; ++run) {
+    const int substeps = 1 + run % 6;
     SimulationOptions options;
     options.physics_substeps = substeps;
+    options.torque_limit = run < 6 ? TorqueLimit::kServo : TorqueLimit::kPd;
     auto character = LoadHumanoid("floating", options);
     Simulation sim(character, options);
     std::mt19937 rng(7);
@@ -197,6 +206,76 @@ TEST(SimulationTest, StepResponseConvergesAtEverySubstepCount) {
       EXPECT_LT(worst_overshoot, 0.3) << "substeps " << substeps;
     }
   }
+}
+
+// The elbow flung from one end of its range toward the other (floating
+// scene, the rest held): under kServo the joint's damping, beyond the
+// elbow's 60 N m, holds it near limit / kd = 2 rad/s; under kPd the limit
+// bounds the whole PD and the elbow goes several times faster, its torque
+// (servo + damping + the damping's cancellation) at the limit meanwhile.
+TEST(SimulationTest, APdTorqueLimitLetsAJointMoveFasterThanItsDampingAllows) {
+  double peak_speed_rad_s[2] = {0.0, 0.0};
+  for (TorqueLimit limit : {TorqueLimit::kServo, TorqueLimit::kPd}) {
+    SimulationOptions options;
+    options.torque_limit = limit;
+    auto character = LoadHumanoid("floating", options);
+    Simulation sim(character, options);
+    int elbow = -1;
+    for (int i = 0; i < character->num_actions(); ++i) {
+      const char* name = mj_id2name(character->model(), mjOBJ_JOINT,
+                                    character->hinges()[i].joint_id);
+      if (std::string(name) == "right_elbow") elbow = i;
+    }
+    ASSERT_GE(elbow, 0);
+    const ActuatedHinge& hinge = character->hinges()[elbow];
+    EXPECT_DOUBLE_EQ(hinge.kp_nm_per_rad, 300.0);
+    EXPECT_DOUBLE_EQ(hinge.kd_nm_s_per_rad, 30.0);
+    EXPECT_DOUBLE_EQ(hinge.torque_high_nm, 60.0);
+    sim.mutable_data()->qpos[hinge.qpos_address] = hinge.range_low_rad + 0.05;
+    sim.Refresh();
+    std::vector<double> targets(character->num_actions(), 0.0);
+    targets[elbow] = hinge.range_high_rad - 0.05;
+    const std::vector<float> actions = ActionsForAngles(*character, targets);
+    double& peak = peak_speed_rad_s[limit == TorqueLimit::kPd];
+    for (int t = 0; t < 60; ++t) {
+      ASSERT_FALSE(sim.Step(actions.data()).diverged()) << SettingName(limit);
+      const double speed = std::abs(sim.data()->qvel[hinge.dof_address]);
+      peak = std::max(peak, speed);
+      EXPECT_LE(std::abs(sim.mean_torques_nm()[elbow]), 60.0 * 1.001)
+          << SettingName(limit) << " step " << t;
+    }
+    // Both arrive (the servo limit slowly).
+    EXPECT_NEAR(HingeAngles(sim)[elbow], targets[elbow], 0.02)
+        << SettingName(limit);
+  }
+  EXPECT_LT(peak_speed_rad_s[0], 2.2);
+  EXPECT_GT(peak_speed_rad_s[1], 3.0 * peak_speed_rad_s[0]);
+  std::printf("elbow's peak speed: servo limit %.2f rad/s, pd limit %.2f\n",
+              peak_speed_rad_s[0], peak_speed_rad_s[1]);
+}
+
+// Within the limits the two are one controller: small steps of the targets
+// give the same states, bit for bit.
+TEST(SimulationTest, WithinItsLimitsAPdLimitChangesNothing) {
+  std::vector<std::vector<double>> qpos_after;
+  for (TorqueLimit limit : {TorqueLimit::kServo, TorqueLimit::kPd}) {
+    SimulationOptions options;
+    options.torque_limit = limit;
+    auto character = LoadHumanoid("floating", options);
+    Simulation sim(character, options);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> offset(-0.03, 0.03);
+    std::vector<double> targets;
+    for (int i = 0; i < character->num_actions(); ++i) {
+      targets.push_back(offset(rng));
+    }
+    const std::vector<float> actions = ActionsForAngles(*character, targets);
+    for (int t = 0; t < 30; ++t)
+      ASSERT_FALSE(sim.Step(actions.data()).diverged());
+    qpos_after.emplace_back(sim.data()->qpos,
+                            sim.data()->qpos + character->model()->nq);
+  }
+  EXPECT_EQ(qpos_after[0], qpos_after[1]);
 }
 
 // Why position servos with joint damping: MuJoCo's Euler integrator treats

@@ -9,19 +9,26 @@
 #   docs/experiments/run_only/eval_curve_3d.sh runs/exp/run_only_3d \
 #     > docs/experiments/run_only/eval_curve_3d.csv
 # MIMIC2D names the binary (default build/mimic2d), DATA the bundles' folder
-# (default runs/dataset, scripts/make_dataset.sh). Eval JSONs are cached in
-# the run folder.
+# (default runs/dataset, scripts/make_dataset.sh). STARTS=estimate evaluates
+# from the fit's starts and cameras instead (runs/dataset/run.json; the
+# table's protocol, for the 2D trials; the windows' columns are then the
+# fit's). Eval JSONs are cached in the run folder, per STARTS.
 set -euo pipefail
 mimic2d=${MIMIC2D:-build/mimic2d}
 data=${DATA:-runs/dataset}
+starts=${STARTS:-truth}
 run=$1
-args=(--bundle "$data/run_truth.json" --starts truth --cameras truth)
+case $starts in
+  truth) args=(--bundle "$data/run_truth.json" --starts truth --cameras truth) ;;
+  estimate) args=(--bundle "$data/run.json" --starts estimate --cameras estimate) ;;
+  *) echo "eval_curve_3d: STARTS must be truth or estimate, not $starts" >&2; exit 2 ;;
+esac
 
-echo "samples,first_frame_frames_view0,view1,view2,view3,first_frame_succ_pct,windows_truth_succ_pct_view0,view1,view2,view3,windows_truth_succ_pct"
+echo "samples,first_frame_frames_view0,view1,view2,view3,first_frame_succ_pct,windows_${starts}_succ_pct_view0,view1,view2,view3,windows_${starts}_succ_pct"
 kept=$run/checkpoints
 for name in $(cd "$kept" && printf '%s\n' ckpt_*.pt | sort -t_ -k2 -n); do
   n=$(basename "$name" .pt | cut -d_ -f2)
-  first=$run/eval_first_$n.json windows=$run/eval_windows_$n.json
+  first=$run/eval_first_${starts}_$n.json windows=$run/eval_windows_${starts}_$n.json
   [ -f "$first" ] || "$mimic2d" eval "$kept/$name" "${args[@]}" \
     --episodes 1 --episode-s 10 -o "$first" > /dev/null
   [ -f "$windows" ] || "$mimic2d" eval "$kept/$name" "${args[@]}" \
