@@ -224,6 +224,8 @@ TEST(TrainConfig, BadConfigsNameTheFileAndTheSetting) {
                     "default");
   ExpectConfigError("data: {bundles: [a.json], cameras: default}\n",
                     "'data.cameras' must be one of truth, estimate");
+  ExpectConfigError("data: {bundles: [a.json]}\nenv: {torque_limit: total}\n",
+                    "'env.torque_limit' must be one of servo, pd");
   ExpectConfigError(
       "data: {bundles: [a.json], initial_states: estimate, cameras: truth}\n",
       "initial_states: estimate needs cameras: estimate");
