@@ -62,8 +62,16 @@ void AddBenchCommand(CLI::App& app, CommandRun* run) {
       ->capture_default_str();
   env->add_option("--seed", options->seed, "Seed of actions and episodes")
       ->capture_default_str();
-  env->callback(
-      [run, options] { *run = [options] { return RunBenchEnv(*options); }; });
+  auto torque_limit = std::make_shared<std::string>("servo");
+  env->add_option("--torque-limit", *torque_limit,
+                  "What the torque limits bound in the environment's loops: "
+                  "servo or pd (env.torque_limit; docs/simulation.md)")
+      ->check(CLI::IsMember({"servo", "pd"}))
+      ->capture_default_str();
+  env->callback([run, options, torque_limit] {
+    ParseSetting(*torque_limit, &options->torque_limit);
+    *run = [options] { return RunBenchEnv(*options); };
+  });
   AddBenchTrainSubcommand(bench, run);
   AddBenchFitSubcommand(bench, run);
 }

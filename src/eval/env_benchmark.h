@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/error.h"
+#include "sim/simulation.h"
 
 namespace m2d {
 
@@ -26,6 +27,9 @@ struct EnvBenchmarkOptions {
   // idle (for shared machines); 0 runs at once.
   double quiet_wait_s = 0.0;
   uint64_t seed = 1;
+  // What the torque limits bound in the environment and Simulation loops
+  // (the bare loops drive MuJoCo's servos directly, as under kServo).
+  TorqueLimit torque_limit = TorqueLimit::kServo;
 
   void Validate() const {
     if (character_config.empty())

@@ -287,6 +287,24 @@ TEST(Cli, AKickedBallIsSimulatedProjectedAndFitted) {
 
 // `clip strip` leaves what a user with videos has: the 2D, no truth, no
 // cameras, no estimate; `clip info` says so.
+// `bench env --torque-limit pd`: the environment under the PD limit, its
+// replay checked against Simulation::Step; a bad value is named.
+TEST(Cli, BenchEnvRunsUnderEitherTorqueLimit) {
+  CommandResult pd = RunMimic2d(
+      "bench env --threads-max 1 --repeats 1 --seconds 0.05 --warmup 5 "
+      "--torque-limit pd");
+  ASSERT_EQ(pd.exit_code, 0) << pd.output;
+  EXPECT_NE(pd.output.find("torque_limit pd"), std::string::npos) << pd.output;
+  // Identical trajectories up to the last bits (as under servo, 1e-15).
+  const std::string check = "replay check: worlds end within ";
+  const size_t at = pd.output.find(check);
+  ASSERT_NE(at, std::string::npos) << pd.output;
+  EXPECT_LT(std::stod(pd.output.substr(at + check.size())), 1e-9) << pd.output;
+  CommandResult bad = RunMimic2d("bench env --torque-limit total");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--torque-limit"), std::string::npos) << bad.output;
+}
+
 // The cells of the row named `name` in a `clip feasibility` table.
 std::vector<std::string> FeasibilityRow(const std::string& output,
                                         const std::string& name) {
