@@ -231,18 +231,11 @@ void PrintFeasibilityTable(const std::vector<FeasibilityRow>& rows,
     for (int t = 0; t < std::min(opening_frames, r.num_frames); ++t) {
       opening_ratio = std::max(opening_ratio, r.frames[t].worst_torque_ratio);
     }
-    const HingeDemand* worst = nullptr;
-    for (const HingeDemand& hinge : r.hinges) {
-      if (hinge.frames_measured == 0) continue;
-      if (!worst ||
-          hinge.peak_nm / hinge.limit_nm > worst->peak_nm / worst->limit_nm) {
-        worst = &hinge;
-      }
-    }
+    const HingeDemand* worst = r.WorstHinge();
     char worst_text[128] = "-";
     if (worst) {
       std::snprintf(worst_text, sizeof(worst_text), "%s %.2f, %d of %d",
-                    worst->actuator.c_str(), worst->peak_nm / worst->limit_nm,
+                    worst->actuator.c_str(), worst->peak_ratio,
                     worst->frames_over_limit, worst->frames_measured);
     }
     std::printf("%-10s %6d %11.1f%% %13.1f%% %9d %11.2f bw %8.2f  %s\n",

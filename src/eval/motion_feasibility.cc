@@ -55,6 +55,15 @@ double MotionFeasibility::MeanForceInFlightBodyWeights() const {
                                             : sum_n / count / body_weight_n;
 }
 
+const HingeDemand* MotionFeasibility::WorstHinge() const {
+  const HingeDemand* worst = nullptr;
+  for (const HingeDemand& hinge : hinges) {
+    if (hinge.frames_measured == 0) continue;
+    if (!worst || hinge.peak_ratio > worst->peak_ratio) worst = &hinge;
+  }
+  return worst;
+}
+
 std::string MotionFeasibility::BriefReport() const {
   int pulls = 0, slips = 0, in_flight = 0;
   for (const FrameDemand& frame : frames) {
@@ -80,15 +89,14 @@ std::string MotionFeasibility::BriefReport() const {
   }
   std::sort(by_ratio.begin(), by_ratio.end(),
             [](const HingeDemand* a, const HingeDemand* b) {
-              return a->peak_nm / a->limit_nm > b->peak_nm / b->limit_nm;
+              return a->peak_ratio > b->peak_ratio;
             });
   out << "  peak demand / limit:";
   for (size_t i = 0; i < std::min<size_t>(3, by_ratio.size()); ++i) {
     const HingeDemand& hinge = *by_ratio[i];
-    out << (i == 0 ? " " : ", ") << hinge.actuator << " "
-        << hinge.peak_nm / hinge.limit_nm << " (frame " << hinge.peak_frame
-        << ", " << hinge.frames_over_limit << " of " << hinge.frames_measured
-        << " over)";
+    out << (i == 0 ? " " : ", ") << hinge.actuator << " " << hinge.peak_ratio
+        << " (frame " << hinge.peak_frame << ", " << hinge.frames_over_limit
+        << " of " << hinge.frames_measured << " over)";
   }
   out << "\n";
   return out.str();
@@ -223,8 +231,9 @@ MotionFeasibility MeasureMotionFeasibility(const Character& character,
           std::abs(torque_nm) / TorqueLimitNm(hinge, torque_nm);
       ++demand.frames_measured;
       if (ratio > 1.0) ++demand.frames_over_limit;
-      if (std::abs(torque_nm) > demand.peak_nm) {
-        demand.peak_nm = std::abs(torque_nm);
+      demand.peak_nm = std::max(demand.peak_nm, std::abs(torque_nm));
+      if (ratio > demand.peak_ratio) {
+        demand.peak_ratio = ratio;
         demand.peak_frame = t;
       }
       if (ratio > frame.worst_torque_ratio) {

@@ -38,12 +38,14 @@ struct FeasibilityOptions {
 // One actuated hinge over a clip.
 struct HingeDemand {
   std::string actuator;   // the MJCF actuator's name
-  double limit_nm = 0.0;  // its torque limit (forcerange x gear)
+  double limit_nm = 0.0;  // its limit toward positive torque (forcerange[1])
   // Frames whose demand does not depend on how the floor pushes: no body
   // below the hinge may be touching it (arms, trunk, a leg in swing).
   int frames_measured = 0;
   int frames_over_limit = 0;  // of those, demand above the limit
   double peak_nm = 0.0;       // largest |torque| over the measured frames
+  // Largest |torque| / the limit in its direction, and its frame.
+  double peak_ratio = 0.0;
   int peak_frame = -1;
 };
 
@@ -75,6 +77,8 @@ struct MotionFeasibility {
   // Mean |external force| over the frames nothing touches, in body weights
   // (0 in a true ballistic flight); 0 without such frames.
   double MeanForceInFlightBodyWeights() const;
+  // The measured hinge with the largest peak_ratio; null if none was.
+  const HingeDemand* WorstHinge() const;
   // A few lines: torque limits, the floor, the worst hinges.
   std::string BriefReport() const;
 };

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -155,11 +154,8 @@ TEST(MotionFeasibility, AnArmSwungTooFastIsOverItsTorqueLimit) {
 
 // The largest peak torque / limit over the measured hinges.
 double PeakRatio(const MotionFeasibility& result) {
-  double ratio = 0.0;
-  for (const HingeDemand& hinge : result.hinges) {
-    ratio = std::max(ratio, hinge.peak_nm / hinge.limit_nm);
-  }
-  return ratio;
+  const HingeDemand* worst = result.WorstHinge();
+  return worst ? worst->peak_ratio : 0.0;
 }
 
 // Under a limit on the whole PD (DeepMimic's) the walk is within reach and
