@@ -222,9 +222,11 @@ struct FeasibilityRow {
 
 void PrintFeasibilityTable(const std::vector<FeasibilityRow>& rows,
                            const Character& character, int opening_frames) {
-  std::printf("%-10s %6s %12s %14s %9s %14s %8s  %s\n", "poses", "frames",
-              "over torque", "floor cannot", "airborne", "flight force",
-              "opening", "worst hinge (peak / limit, frames over)");
+  std::printf("%-10s %6s %12s %13s %13s %15s %14s %9s %14s %8s  %s; %s\n",
+              "poses", "frames", "over torque", "out of range", "out of reach",
+              "self-overlap", "floor cannot", "airborne", "flight force",
+              "opening", "worst hinge (peak / limit, frames over)",
+              "furthest out of range (deg past, frames)");
   for (const FeasibilityRow& row : rows) {
     const MotionFeasibility& r = row.result;
     double opening_ratio = 0.0;
@@ -238,36 +240,69 @@ void PrintFeasibilityTable(const std::vector<FeasibilityRow>& rows,
                     worst->actuator.c_str(), worst->peak_ratio,
                     worst->frames_over_limit, worst->frames_measured);
     }
-    std::printf("%-10s %6d %11.1f%% %13.1f%% %9d %11.2f bw %8.2f  %s\n",
-                row.name.c_str(), r.num_frames,
-                100.0 * r.FramesOverTorqueLimit() / r.num_frames,
-                100.0 * r.FramesFloorCannotExplain() / r.num_frames,
-                r.AirborneFrames(), r.MeanForceInFlightBodyWeights(),
-                opening_ratio, worst_text);
+    const HingeDemand* out_of_range = r.WorstRangeHinge();
+    char range_text[128] = "-";
+    if (out_of_range) {
+      std::snprintf(range_text, sizeof(range_text), "%s %.1f, %d",
+                    out_of_range->actuator.c_str(),
+                    out_of_range->peak_range_excess_rad * 180.0 / M_PI,
+                    out_of_range->frames_out_of_range);
+    }
+    std::printf(
+        "%-10s %6d %11.1f%% %12.1f%% %5.1f%% %4.2f m %6.1f%% %4.1f cm "
+        "%13.1f%% %9d %11.2f bw %8.2f  %s; %s\n",
+        row.name.c_str(), r.num_frames,
+        100.0 * r.FramesOverTorqueLimit() / r.num_frames,
+        100.0 * r.FramesOutOfRange() / r.num_frames,
+        100.0 * r.FramesOutOfReach() / r.num_frames, r.WorstReachErrorM(),
+        100.0 * r.FramesSelfPenetrating() / r.num_frames,
+        r.DeepestSelfPenetration()
+            ? 100.0 * r.DeepestSelfPenetration()->self_penetration_m
+            : 0.0,
+        100.0 * r.FramesFloorCannotExplain() / r.num_frames, r.AirborneFrames(),
+        r.MeanForceInFlightBodyWeights(), opening_ratio, worst_text,
+        range_text);
   }
   std::printf(
       "over torque: frames in which a hinge the floor cannot reach needs more "
-      "than its limit; floor cannot: a force needed in flight, a pull or a "
+      "than its limit; out of range: frames in which some hinge angle has no "
+      "solution within its joint range (%.1f deg of tolerance); out of "
+      "reach: frames whose nearest pose within every range leaves a body "
+      "keypoint more than %.2f m off, and the worst distance; "
+      "self-overlap: frames in which two of the character's own geoms "
+      "overlap by more than %.1f cm, and the deepest; floor "
+      "cannot: a force needed in flight, a pull or a "
       "slip; flight force: mean external force while airborne, in %s's "
       "body weights; opening: the worst torque / limit over the first %d "
       "frames\n",
+      rows.empty() ? 0.0 : rows[0].result.range_tolerance_rad * 180.0 / M_PI,
+      rows.empty() ? 0.0 : rows[0].result.reach_tolerance_m,
+      rows.empty() ? 0.0 : 100.0 * rows[0].result.penetration_tolerance_m,
       character.name().c_str(), opening_frames);
 }
 
 void WriteFeasibilityFramesCsv(const std::string& path,
                                const std::vector<FeasibilityRow>& rows) {
   std::string csv =
-      "poses,frame,touching,worst_torque_ratio,worst_hinge,force_x_n,"
-      "force_y_n,force_z_n,force_in_flight,pulls_floor,slips\n";
+      "poses,frame,touching,worst_torque_ratio,worst_hinge,"
+      "range_excess_deg,range_hinge,reach_error_m,self_penetration_m,"
+      "self_contact,force_x_n,force_y_n,force_z_n,"
+      "force_in_flight,pulls_floor,slips\n";
   char line[256];
   for (const FeasibilityRow& row : rows) {
     const MotionFeasibility& r = row.result;
     for (int t = 0; t < r.num_frames; ++t) {
       const FrameDemand& f = r.frames[t];
       std::snprintf(
-          line, sizeof(line), "%s,%d,%d,%.3f,%s,%.1f,%.1f,%.1f,%d,%d,%d\n",
+          line, sizeof(line),
+          "%s,%d,%d,%.3f,%s,%.1f,%s,%.3f,%.3f,%s,%.1f,%.1f,%.1f,%d,%d,%d\n",
           row.name.c_str(), t, f.touching ? 1 : 0, f.worst_torque_ratio,
           f.worst_hinge < 0 ? "" : r.hinges[f.worst_hinge].actuator.c_str(),
+          f.worst_range_excess_rad * 180.0 / M_PI,
+          f.worst_range_hinge < 0
+              ? ""
+              : r.hinges[f.worst_range_hinge].actuator.c_str(),
+          f.reach_error_m, f.self_penetration_m, f.self_contact.c_str(),
           f.external_force_n.x(), f.external_force_n.y(),
           f.external_force_n.z(), f.force_in_flight ? 1 : 0,
           f.pulls_floor ? 1 : 0, f.slips ? 1 : 0);

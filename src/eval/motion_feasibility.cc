@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "fit/kinematics.h"
+#include "fit/retarget.h"
 #include "sim/mujoco_handles.h"
 #include "sim/pose_mapping.h"
 #include "sim/simulation.h"
@@ -22,12 +24,62 @@ void FeasibilityOptions::Validate() const {
   if (!(force_tolerance_body_weights >= 0.0)) {
     throw ConfigError("feasibility force_tolerance_body_weights must be >= 0");
   }
+  if (!(range_tolerance_rad >= 0.0)) {
+    throw ConfigError("feasibility range_tolerance_rad must be >= 0 rad");
+  }
+  if (!(reach_tolerance_m >= 0.0)) {
+    throw ConfigError("feasibility reach_tolerance_m must be >= 0 m");
+  }
+  if (!(penetration_tolerance_m >= 0.0)) {
+    throw ConfigError("feasibility penetration_tolerance_m must be >= 0 m");
+  }
 }
 
 int MotionFeasibility::FramesOverTorqueLimit() const {
   return static_cast<int>(std::count_if(
       frames.begin(), frames.end(),
       [](const FrameDemand& f) { return f.worst_torque_ratio > 1.0; }));
+}
+
+int MotionFeasibility::FramesOutOfRange() const {
+  const double tolerance_rad = range_tolerance_rad;
+  return static_cast<int>(std::count_if(
+      frames.begin(), frames.end(), [tolerance_rad](const FrameDemand& f) {
+        return f.worst_range_excess_rad > tolerance_rad;
+      }));
+}
+
+int MotionFeasibility::FramesOutOfReach() const {
+  const double tolerance_m = reach_tolerance_m;
+  return static_cast<int>(std::count_if(frames.begin(), frames.end(),
+                                        [tolerance_m](const FrameDemand& f) {
+                                          return f.reach_error_m > tolerance_m;
+                                        }));
+}
+
+double MotionFeasibility::WorstReachErrorM() const {
+  double worst_m = 0.0;
+  for (const FrameDemand& frame : frames)
+    worst_m = std::max(worst_m, frame.reach_error_m);
+  return worst_m;
+}
+
+int MotionFeasibility::FramesSelfPenetrating() const {
+  const double tolerance_m = penetration_tolerance_m;
+  return static_cast<int>(std::count_if(
+      frames.begin(), frames.end(), [tolerance_m](const FrameDemand& f) {
+        return f.self_penetration_m > tolerance_m;
+      }));
+}
+
+const FrameDemand* MotionFeasibility::DeepestSelfPenetration() const {
+  const FrameDemand* deepest = nullptr;
+  for (const FrameDemand& frame : frames) {
+    if (frame.self_penetration_m <= 0.0) continue;
+    if (!deepest || frame.self_penetration_m > deepest->self_penetration_m)
+      deepest = &frame;
+  }
+  return deepest;
 }
 
 int MotionFeasibility::FramesFloorCannotExplain() const {
@@ -64,6 +116,17 @@ const HingeDemand* MotionFeasibility::WorstHinge() const {
   return worst;
 }
 
+const HingeDemand* MotionFeasibility::WorstRangeHinge() const {
+  const HingeDemand* worst = nullptr;
+  for (const HingeDemand& hinge : hinges) {
+    if (hinge.peak_range_excess_rad <= 0.0) continue;
+    if (!worst || hinge.peak_range_excess_rad > worst->peak_range_excess_rad) {
+      worst = &hinge;
+    }
+  }
+  return worst;
+}
+
 std::string MotionFeasibility::BriefReport() const {
   int pulls = 0, slips = 0, in_flight = 0;
   for (const FrameDemand& frame : frames) {
@@ -77,6 +140,24 @@ std::string MotionFeasibility::BriefReport() const {
   out << num_frames << " frames at " << fps << " Hz, body weight "
       << body_weight_n << " N\n";
   out << "  over a torque limit: " << FramesOverTorqueLimit() << " frames\n";
+  out << "  out of a joint range: " << FramesOutOfRange() << " frames";
+  if (const HingeDemand* worst = WorstRangeHinge()) {
+    out << " (furthest " << worst->actuator << " "
+        << worst->peak_range_excess_rad * 180.0 / M_PI << " deg, frame "
+        << worst->peak_range_frame << ", " << worst->frames_out_of_range
+        << " frames)";
+  }
+  out << "\n";
+  out << "  out of reach within the ranges: " << FramesOutOfReach()
+      << " frames (a body keypoint more than " << reach_tolerance_m
+      << " m off; worst " << WorstReachErrorM() << " m)\n";
+  out << "  self-penetrating: " << FramesSelfPenetrating() << " frames";
+  if (const FrameDemand* deepest = DeepestSelfPenetration()) {
+    out << " (deepest " << deepest->self_contact << " "
+        << deepest->self_penetration_m << " m, frame "
+        << deepest - frames.data() << ")";
+  }
+  out << "\n";
   out << "  the floor cannot explain: " << FramesFloorCannotExplain()
       << " frames (" << in_flight << " force in flight, " << pulls << " pull, "
       << slips << " slip); airborne " << AirborneFrames()
@@ -129,6 +210,84 @@ std::vector<char> BodiesAboveAContact(const Character& character,
   return above;
 }
 
+// Per frame, how far the nearest pose within the joint ranges leaves a body
+// keypoint: the pose's own keypoints (its angles as they are: MuJoCo's
+// kinematics ignores ranges), fitted by in-range hinges from the frame's
+// range-nearest angles clamped. Frames already within the ranges are 0.
+void MeasureReach(const Character& character, const std::vector<Pose3D>& poses,
+                  MotionFeasibility* result) {
+  const KinematicModel model = KinematicModel::FromCharacter(character);
+  const int num_hinges = model.num_hinges();
+  std::vector<double> qpos(character.model()->nq);
+  std::vector<double> points(3 *
+                             (model.num_keypoints() + model.num_sole_points()));
+  std::vector<std::vector<Eigen::Vector3d>> keypoints_m;
+  std::vector<Eigen::VectorXd> starts_rad;
+  std::vector<int> frames_to_fit;
+  for (size_t t = 0; t < poses.size(); ++t) {
+    if (result->frames[t].worst_range_excess_rad <= 0.0) continue;
+    PoseToQpos(character, poses[t], qpos.data());
+    Eigen::VectorXd hinges(num_hinges);
+    for (int h = 0; h < num_hinges; ++h)
+      hinges[h] = qpos[character.hinges()[h].qpos_address];
+    const double* root = qpos.data() + character.root_qpos_address();
+    CharacterPoints(model, root, root + 3, hinges.data(), points.data());
+    std::vector<Eigen::Vector3d> frame_points;
+    for (int j = 0; j < model.num_keypoints(); ++j)
+      frame_points.emplace_back(points[3 * j], points[3 * j + 1],
+                                points[3 * j + 2]);
+    keypoints_m.push_back(std::move(frame_points));
+    starts_rad.push_back(hinges);
+    frames_to_fit.push_back(static_cast<int>(t));
+  }
+  if (frames_to_fit.empty()) return;
+  // Each frame on its own: no pull toward rest or the previous frame.
+  RetargetOptions options;
+  options.rest_weight = 0.0;
+  options.continuity_weight = 0.0;
+  options.max_iterations = 100;
+  RetargetSummary summary;
+  RetargetKeypointsToHinges(character, keypoints_m, options, "feasibility",
+                            &summary, &starts_rad);
+  for (size_t i = 0; i < frames_to_fit.size(); ++i) {
+    result->frames[frames_to_fit[i]].reach_error_m =
+        summary.frame_worst_error_m[i];
+  }
+}
+
+// Per frame, the deepest overlap between two of the character's own geoms
+// (collision detection on the character's model as simulated: its contype,
+// conaffinity and parent-child exclusions decide which pairs can touch).
+void MeasureSelfPenetration(const Character& character,
+                            const std::vector<std::vector<double>>& qpos,
+                            MotionFeasibility* result) {
+  const mjModel* m = character.model();
+  MujocoDataPtr data = MakeMujocoData(m);
+  mjData* d = data.get();
+  for (size_t t = 0; t < qpos.size(); ++t) {
+    std::copy(qpos[t].begin(), qpos[t].end(), d->qpos);
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_collision(m, d);
+    FrameDemand& frame = result->frames[t];
+    for (int c = 0; c < d->ncon; ++c) {
+      const mjContact& contact = d->contact[c];
+      const int body1 = m->geom_bodyid[contact.geom1];
+      const int body2 = m->geom_bodyid[contact.geom2];
+      if (!character.IsCharacterBody(body1) ||
+          !character.IsCharacterBody(body2) || -contact.dist <= 0.0 ||
+          -contact.dist <= frame.self_penetration_m) {
+        continue;
+      }
+      frame.self_penetration_m = -contact.dist;
+      const char* name1 = mj_id2name(m, mjOBJ_GEOM, contact.geom1);
+      const char* name2 = mj_id2name(m, mjOBJ_GEOM, contact.geom2);
+      frame.self_contact =
+          std::string(name1 ? name1 : "?") + "/" + (name2 ? name2 : "?");
+    }
+  }
+}
+
 }  // namespace
 
 MotionFeasibility MeasureMotionFeasibility(const Character& character,
@@ -156,6 +315,9 @@ MotionFeasibility MeasureMotionFeasibility(const Character& character,
 
   std::vector<std::vector<double>> qpos =
       PosesToQposAlongClip(character, poses);
+  // Each frame's solution nearest the ranges, for the range check: the
+  // continuous one above may sit on the other Euler branch.
+  std::vector<double> nearest_range_qpos(m->nq);
   for (int t = 0; t < num_frames; ++t) {
     for (const FreeObject& object : character.free_objects()) {
       std::copy(m->qpos0 + object.qpos_address,
@@ -182,6 +344,9 @@ MotionFeasibility MeasureMotionFeasibility(const Character& character,
 
   MotionFeasibility result;
   result.num_frames = num_frames;
+  result.range_tolerance_rad = options.range_tolerance_rad;
+  result.reach_tolerance_m = options.reach_tolerance_m;
+  result.penetration_tolerance_m = options.penetration_tolerance_m;
   result.fps = fps;
   double mass_kg = 0.0;
   for (int body : character.bodies()) mass_kg += m->body_mass[body];
@@ -215,6 +380,24 @@ MotionFeasibility MeasureMotionFeasibility(const Character& character,
     mj_inverse(m, d);
 
     FrameDemand frame;
+    PoseToQpos(character, poses[t], nearest_range_qpos.data());
+    for (size_t h = 0; h < character.hinges().size(); ++h) {
+      const ActuatedHinge& hinge = character.hinges()[h];
+      const double angle_rad = nearest_range_qpos[hinge.qpos_address];
+      const double excess_rad = std::max({0.0, hinge.range_low_rad - angle_rad,
+                                          angle_rad - hinge.range_high_rad});
+      HingeDemand& demand = result.hinges[h];
+      if (excess_rad > options.range_tolerance_rad)
+        ++demand.frames_out_of_range;
+      if (excess_rad > demand.peak_range_excess_rad) {
+        demand.peak_range_excess_rad = excess_rad;
+        demand.peak_range_frame = t;
+      }
+      if (excess_rad > frame.worst_range_excess_rad) {
+        frame.worst_range_excess_rad = excess_rad;
+        frame.worst_range_hinge = static_cast<int>(h);
+      }
+    }
     const std::vector<char> above_contact = BodiesAboveAContact(
         character, m, d, options.contact_height_m, &frame.touching);
     for (size_t h = 0; h < character.hinges().size(); ++h) {
@@ -257,6 +440,8 @@ MotionFeasibility MeasureMotionFeasibility(const Character& character,
     }
     result.frames.push_back(frame);
   }
+  MeasureReach(character, poses, &result);
+  MeasureSelfPenetration(character, qpos, &result);
   return result;
 }
 

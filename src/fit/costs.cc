@@ -102,6 +102,10 @@ std::vector<int32_t> SlideBlockSizes(const KinematicModel& model) {
           kRootPositionSize, kRootQuaternionSize, hinges};
 }
 
+std::vector<int32_t> SelfContactBlockSizes(const KinematicModel& model) {
+  return {kRootPositionSize, kRootQuaternionSize, model.num_hinges()};
+}
+
 std::vector<int32_t> BalanceBlockSizes(const KinematicModel& model) {
   std::vector<int32_t> sizes;
   for (int frame = 0; frame < 3; ++frame) {
@@ -268,6 +272,69 @@ ceres::CostFunction* FootSlideCost::Create(FootSlideCost cost) {
   const int num_residuals = 2 * cost.model->num_sole_points();
   return new AnalyticCostFunction<FootSlideCost>(std::move(cost), sizes,
                                                  num_residuals);
+}
+
+bool SelfContactCost::Evaluate(double const* const* blocks, double* residuals,
+                               double** jacobians) const {
+  // Outline: the centres of the spheres the pairs name, with their pose
+  // Jacobian; per pair the overlap r_a + r_b - |c_a - c_b| (0 when apart)
+  // and, where they overlap, its derivative -u . (dc_a - dc_b), u the unit
+  // vector from b to a.
+  const int num_hinges = model->num_hinges();
+  const int columns = PoseJacobianColumns(*model);
+  const int num_pairs = static_cast<int>(pairs.size());
+  ZeroJacobians(jacobians, SelfContactBlockSizes(*model), num_pairs);
+  std::vector<int> slot(model->collision_spheres.size(), -1);
+  std::vector<BodyPoint> centres;
+  for (const auto& [a, b] : pairs) {
+    for (int sphere : {a, b}) {
+      if (slot[sphere] >= 0) continue;
+      slot[sphere] = static_cast<int>(centres.size());
+      centres.push_back(model->collision_spheres[sphere].centre);
+    }
+  }
+  std::vector<double> points(3 * centres.size());
+  std::vector<double> jacobian;
+  if (jacobians != nullptr) jacobian.resize(points.size() * columns);
+  BodyPointsWithJacobian(*model, blocks[0], blocks[1], blocks[2], centres,
+                         points.data(),
+                         jacobians != nullptr ? jacobian.data() : nullptr);
+  constexpr int kBlockStart[3] = {0, kRootPositionSize,
+                                  kRootPositionSize + kRootQuaternionSize};
+  const int block_size[3] = {kRootPositionSize, kRootQuaternionSize,
+                             num_hinges};
+  for (int r = 0; r < num_pairs; ++r) {
+    const auto [a, b] = pairs[r];
+    const Eigen::Vector3d from_b =
+        Eigen::Map<const Eigen::Vector3d>(&points[3 * slot[a]]) -
+        Eigen::Map<const Eigen::Vector3d>(&points[3 * slot[b]]);
+    const double distance_m = from_b.norm();
+    const double overlap_m = model->collision_spheres[a].radius_m +
+                             model->collision_spheres[b].radius_m - distance_m;
+    residuals[r] = overlap_m > 0.0 ? weight * overlap_m : 0.0;
+    if (jacobians == nullptr || overlap_m <= 0.0 || distance_m < 1e-9) continue;
+    const Eigen::Vector3d unit = from_b / distance_m;
+    for (int k = 0; k < 3; ++k) {
+      if (jacobians[k] == nullptr) continue;
+      double* row = jacobians[k] + r * block_size[k];
+      for (int c = 0; c < 3; ++c) {
+        const double* row_a =
+            jacobian.data() + (3 * slot[a] + c) * columns + kBlockStart[k];
+        const double* row_b =
+            jacobian.data() + (3 * slot[b] + c) * columns + kBlockStart[k];
+        for (int i = 0; i < block_size[k]; ++i)
+          row[i] -= weight * unit[c] * (row_a[i] - row_b[i]);
+      }
+    }
+  }
+  return true;
+}
+
+ceres::CostFunction* SelfContactCost::Create(SelfContactCost cost) {
+  const std::vector<int32_t> sizes = SelfContactBlockSizes(*cost.model);
+  const int num_residuals = static_cast<int>(cost.pairs.size());
+  return new AnalyticCostFunction<SelfContactCost>(std::move(cost), sizes,
+                                                   num_residuals);
 }
 
 bool BalanceCost::Evaluate(double const* const* blocks, double* residuals,

@@ -176,6 +176,24 @@ struct FootSlideCost {
   static ceres::CostFunction* Create(FootSlideCost cost);
 };
 
+// Bodies that do not pass through each other (blocks: one frame's root
+// position, quaternion, hinges): per pair of the character's collision
+// spheres (KinematicModel::collision_pairs) chosen when the solve is built,
+// weight x how deeply the two overlap (m; 0 when apart). SMPLify's
+// interpenetration term with spheres for capsules: without it, 2D lets a
+// leg pass behind the other through it, or a forearm through the waist.
+struct SelfContactCost {
+  const KinematicModel* model;
+  std::vector<std::pair<int, int>> pairs;  // indices of collision spheres
+  double weight = 0.0;
+
+  // Residuals and requested Jacobians (analytic, BodyPointsWithJacobian).
+  bool Evaluate(double const* const* blocks, double* residuals,
+                double** jacobians) const;
+
+  static ceres::CostFunction* Create(SelfContactCost cost);
+};
+
 // Balance (blocks: the root position, quaternion and hinges of frames
 // t - k, t and t + k): the zero-moment point of frame t, from the centre of
 // mass c and its acceleration a = (c[t-k] - 2 c[t] + c[t+k]) / (k dt)^2

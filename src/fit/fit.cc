@@ -695,6 +695,30 @@ void AddMeanBalance(const KinematicModel& model, double weight, double window_s,
   }
 }
 
+// The collision-sphere pairs of frame `t` of `params` whose surfaces are
+// closer than `margin_m` (overlapping ones included).
+std::vector<std::pair<int, int>> NearSpherePairs(const KinematicModel& model,
+                                                 const Parameters& params,
+                                                 int t, double margin_m) {
+  std::vector<BodyPoint> centres;
+  for (const CollisionSphere& sphere : model.collision_spheres)
+    centres.push_back(sphere.centre);
+  std::vector<double> points(3 * centres.size());
+  BodyPointsWithJacobian(
+      model, params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+      params.hinges_rad[t].data(), centres, points.data(), nullptr);
+  std::vector<std::pair<int, int>> near;
+  for (const auto& [a, b] : model.collision_pairs) {
+    const double gap_m = (Eigen::Map<const Eigen::Vector3d>(&points[3 * a]) -
+                          Eigen::Map<const Eigen::Vector3d>(&points[3 * b]))
+                             .norm() -
+                         model.collision_spheres[a].radius_m -
+                         model.collision_spheres[b].radius_m;
+    if (gap_m < margin_m) near.push_back({a, b});
+  }
+  return near;
+}
+
 // Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
 // them out); `term_blocks` (optional) records which term each block is.
 void BuildProblem(Stage stage, const Observations& obs,
@@ -776,6 +800,24 @@ void BuildProblem(Stage stage, const Observations& obs,
     for (int h = 0; h < num_hinges; ++h) {
       problem.SetParameterLowerBound(hinges, h, model.hinge_low_rad[h]);
       problem.SetParameterUpperBound(hinges, h, model.hinge_high_rad[h]);
+    }
+  }
+  // Bodies that do not pass through each other: per frame, the sphere
+  // pairs near enough to touch in the estimate the solve starts from. From
+  // stage 3 on: in stage 2 a limb the search put on the wrong side of
+  // another must be free to pass through it to the right one.
+  if (HasContactTerms(stage) && options.self_contact_weight > 0) {
+    for (int t = 0; t < num_frames; ++t) {
+      SelfContactCost cost;
+      cost.model = &model;
+      cost.weight = options.self_contact_weight;
+      cost.pairs =
+          NearSpherePairs(model, params, t, options.self_contact_margin_m);
+      if (cost.pairs.empty()) continue;
+      AddTerm(problem, term_blocks, FitTerm::kSelfContact,
+              SelfContactCost::Create(std::move(cost)),
+              {params.root_m[t].data(), params.quaternion_wxyz[t].data(),
+               params.hinges_rad[t].data()});
     }
   }
   // Feet that stay put while on the floor.
@@ -1618,6 +1660,8 @@ const char* FitTermName(FitTerm term) {
       return "camera speed";
     case FitTerm::kCameraSmooth:
       return "camera smooth";
+    case FitTerm::kSelfContact:
+      return "self contact";
   }
   return "?";
 }

@@ -94,11 +94,16 @@ struct FitOptions {
   double turn_smooth_weight = 8.0;      // root angular accel., rad per frame^2
   double ground_weight = 10.0;          // lowest sole point's height (m)
   double penetration_weight = 100.0;    // each sole point below z = 0 (m)
-  double foot_slide_weight = 30.0;      // in-contact sole point step (m)
-  double camera_smooth_weight = 400.0;  // moving centre accel., m/frame^2
-  double camera_speed_weight = 0.5;     // moving centre speed, m per frame
-  double focal_prior_weight = 2.0;      // log(focal / prior)
-  double upright_weight = 0.5;          // root up axis, horizontal part
+  // Two of the character's collision spheres overlapping (m): legs and arms
+  // that 2D alone lets pass through each other or the trunk. Pairs closer
+  // than self_contact_margin_m when a stage's solve is built are watched.
+  double self_contact_weight = 20.0;
+  double self_contact_margin_m = 0.05;
+  double foot_slide_weight = 30.0;        // in-contact sole point step (m)
+  double camera_smooth_weight = 400.0;    // moving centre accel., m/frame^2
+  double camera_speed_weight = 0.5;       // moving centre speed, m per frame
+  double focal_prior_weight = 2.0;        // log(focal / prior)
+  double upright_weight = 0.5;            // root up axis, horizontal part
   double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
   // Balance (stage 3, frames with a sole in contact): the zero-moment point
   // outside the in-contact soles' box grown by the margin (m); the centre
@@ -226,6 +231,12 @@ struct FitOptions {
       "lowest sole point's height (m)");
     v("penetration_weight", self.penetration_weight, weight,
       "each sole point below the floor (m)");
+    v("self_contact_weight", self.self_contact_weight, weight,
+      "two of the character's collision spheres overlapping (m): a leg or "
+      "arm through another or through the trunk; 0: off");
+    v("self_contact_margin_m", self.self_contact_margin_m, Range::AtLeast(0),
+      "sphere pairs closer than this when a stage's solve is built are "
+      "watched for overlap (m)");
     v("foot_slide_weight", self.foot_slide_weight, weight,
       "in-contact sole point's step (m)");
     v("camera_smooth_weight", self.camera_smooth_weight, weight,
@@ -355,8 +366,9 @@ enum class FitTerm {
   kCameraHeightPrior,
   kCameraSpeed,
   kCameraSmooth,
+  kSelfContact,
 };
-inline constexpr int kNumFitTerms = 16;
+inline constexpr int kNumFitTerms = 17;
 const char* FitTermName(FitTerm term);
 
 // An objective's cost at one state, term by term (each 1/2 the sum of its

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 
 #include "common/error.h"
 #include "sim/character.h"
@@ -128,6 +129,122 @@ class PoseJacobianContext {
   int free_joint_ = -1;
 };
 
+// Spheres along a segment from `a` to `b` (joint frame, m) of `radius_m`,
+// spaced at most one radius apart, both ends included: their union is the
+// capsule's to within 14 % of its radius at the waist between two spheres.
+void AddSphereRow(int joint, int geom, const Eigen::Vector3d& a,
+                  const Eigen::Vector3d& b, double radius_m,
+                  std::vector<CollisionSphere>* spheres) {
+  const double length_m = (b - a).norm();
+  const int count =
+      1 + static_cast<int>(std::ceil(length_m / std::max(radius_m, 1e-6)));
+  for (int i = 0; i < count; ++i) {
+    const double s = count == 1 ? 0.5 : static_cast<double>(i) / (count - 1);
+    spheres->push_back({{joint, a + s * (b - a)}, radius_m, geom});
+  }
+}
+
+// Whether MuJoCo's collision filter lets bodies `b1` and `b2` of `m` touch
+// through geoms `g1` and `g2`: contype/conaffinity, no parent-child pair
+// (filterparent), no <exclude>.
+bool MayCollide(const mjModel* m, int g1, int g2) {
+  const int b1 = m->geom_bodyid[g1], b2 = m->geom_bodyid[g2];
+  if (b1 == b2) return false;
+  if (!((m->geom_contype[g1] & m->geom_conaffinity[g2]) ||
+        (m->geom_contype[g2] & m->geom_conaffinity[g1]))) {
+    return false;
+  }
+  const bool filter_parent = !(m->opt.disableflags & mjDSBL_FILTERPARENT);
+  if (filter_parent && ((m->body_parentid[b1] == b2 && b2 != 0) ||
+                        (m->body_parentid[b2] == b1 && b1 != 0))) {
+    return false;
+  }
+  const int signature = (std::min(b1, b2) << 16) + std::max(b1, b2);
+  for (int e = 0; e < m->nexclude; ++e) {
+    if (m->exclude_signature[e] == signature) return false;
+  }
+  return true;
+}
+
+// The character's collision geoms as spheres in their joints' frames, and
+// the pairs of them that may collide and are apart at rest. Spheres are
+// one sphere; capsules and boxes a row along their long axis (a box's
+// radius its smaller cross half-size); other shapes are left out.
+void AddCollisionSpheres(const Character& character, KinematicModel* model) {
+  const mjModel* m = character.model();
+  const Skeleton& skeleton = character.skeleton();
+  for (int g = 0; g < m->ngeom; ++g) {
+    const int body = m->geom_bodyid[g];
+    if (!character.IsCharacterBody(body)) continue;
+    if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) continue;
+    int joint = -1;
+    for (int j = 0; j < skeleton.num_joints(); ++j) {
+      if (character.joints()[j].body_id == body) joint = j;
+    }
+    if (joint < 0) continue;
+    const Eigen::Vector3d centre(m->geom_pos + 3 * g);
+    const Eigen::Matrix3d axes =
+        Eigen::Quaterniond(m->geom_quat[4 * g], m->geom_quat[4 * g + 1],
+                           m->geom_quat[4 * g + 2], m->geom_quat[4 * g + 3])
+            .normalized()
+            .toRotationMatrix();
+    const double* size = m->geom_size + 3 * g;
+    switch (m->geom_type[g]) {
+      case mjGEOM_SPHERE:
+        model->collision_spheres.push_back({{joint, centre}, size[0], g});
+        break;
+      case mjGEOM_CAPSULE: {
+        const Eigen::Vector3d half = size[1] * axes.col(2);
+        AddSphereRow(joint, g, centre - half, centre + half, size[0],
+                     &model->collision_spheres);
+        break;
+      }
+      case mjGEOM_BOX: {
+        int longest = 0;
+        for (int k = 1; k < 3; ++k)
+          if (size[k] > size[longest]) longest = k;
+        const double radius_m =
+            std::min(size[(longest + 1) % 3], size[(longest + 2) % 3]);
+        const Eigen::Vector3d half =
+            std::max(0.0, size[longest] - radius_m) * axes.col(longest);
+        AddSphereRow(joint, g, centre - half, centre + half, radius_m,
+                     &model->collision_spheres);
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  // The rest pose (hinges at 0, clamped into their ranges) decides which
+  // pairs are apart by design: those that touch there are neighbours.
+  std::vector<double> rest(model->num_hinges());
+  for (int h = 0; h < model->num_hinges(); ++h)
+    rest[h] =
+        std::clamp(0.0, model->hinge_low_rad[h], model->hinge_high_rad[h]);
+  const double origin[3] = {0, 0, 0};
+  const double identity[4] = {1, 0, 0, 0};
+  std::vector<BodyPoint> centres;
+  for (const CollisionSphere& sphere : model->collision_spheres)
+    centres.push_back(sphere.centre);
+  std::vector<double> at_rest(3 * centres.size());
+  BodyPointsWithJacobian(*model, origin, identity, rest.data(), centres,
+                         at_rest.data(), nullptr);
+  const int num_spheres = static_cast<int>(centres.size());
+  for (int a = 0; a < num_spheres; ++a) {
+    for (int b = a + 1; b < num_spheres; ++b) {
+      const CollisionSphere& sa = model->collision_spheres[a];
+      const CollisionSphere& sb = model->collision_spheres[b];
+      if (!MayCollide(m, sa.geom, sb.geom)) continue;
+      const double distance_m =
+          (Eigen::Map<const Eigen::Vector3d>(&at_rest[3 * a]) -
+           Eigen::Map<const Eigen::Vector3d>(&at_rest[3 * b]))
+              .norm();
+      if (distance_m <= sa.radius_m + sb.radius_m) continue;
+      model->collision_pairs.push_back({a, b});
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<char> JointsMovedBy(const KinematicModel& model,
@@ -170,6 +287,38 @@ void CharacterPointsWithJacobian(const KinematicModel& model,
       for (int c = 0; c < 3; ++c) points_m[row + c] = world[c];
       row += 3;
     }
+  }
+}
+
+void BodyPointsWithJacobian(const KinematicModel& model,
+                            const double* root_position_m,
+                            const double* root_quaternion_wxyz,
+                            const double* hinges_rad,
+                            const std::vector<BodyPoint>& points,
+                            double* points_m, double* jacobian) {
+  if (jacobian == nullptr) {
+    Eigen::Matrix3d orientation[kMaxFitJoints];
+    Eigen::Vector3d position[kMaxFitJoints];
+    JointFrames(model, root_position_m, root_quaternion_wxyz, hinges_rad,
+                orientation, position);
+    for (size_t p = 0; p < points.size(); ++p) {
+      const Eigen::Vector3d world =
+          position[points[p].joint] +
+          orientation[points[p].joint] * points[p].offset_m;
+      for (int c = 0; c < 3; ++c) points_m[3 * p + c] = world[c];
+    }
+    return;
+  }
+  const PoseJacobianContext context(model, root_position_m,
+                                    root_quaternion_wxyz, hinges_rad);
+  const int columns = PoseJacobianColumns(model);
+  std::fill(jacobian, jacobian + 3 * points.size() * columns, 0.0);
+  for (size_t p = 0; p < points.size(); ++p) {
+    double* const rows[3] = {jacobian + 3 * p * columns,
+                             jacobian + (3 * p + 1) * columns,
+                             jacobian + (3 * p + 2) * columns};
+    const Eigen::Vector3d world = context.AddPoint(points[p], 1.0, rows);
+    for (int c = 0; c < 3; ++c) points_m[3 * p + c] = world[c];
   }
 }
 
@@ -294,6 +443,7 @@ KinematicModel KinematicModel::FromCharacter(const Character& character) {
     lowest_m = std::min(lowest_m, points[3 * (model.num_keypoints() + s) + 2]);
   }
   model.standing_root_height_m = -lowest_m;
+  AddCollisionSpheres(character, &model);
   return model;
 }
 

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "motion/motion3d.h"
@@ -27,6 +28,15 @@ class Character;
 struct BodyPoint {
   int joint = 0;
   Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
+};
+
+// A sphere fixed in one joint's frame: the fit's stand-in for the
+// character's collision geoms (a capsule or a box is a row of them), as
+// SMPLify stands spheres in for its capsules.
+struct CollisionSphere {
+  BodyPoint centre;
+  double radius_m = 0.0;
+  int geom = -1;  // the MuJoCo geom it stands in for
 };
 
 // The character's kinematic tree as plain data, read once from a Character.
@@ -57,6 +67,12 @@ struct KinematicModel {
   std::vector<double> hinge_low_rad;  // MJCF ranges, in action order
   std::vector<double> hinge_high_rad;
   double standing_root_height_m = 0.0;  // root z with soles on the floor
+  std::vector<CollisionSphere> collision_spheres;
+  // Pairs of collision spheres (indices, first < second) that the
+  // simulation lets collide (different bodies, not parent and child, not
+  // excluded, contype and conaffinity matching) and that are apart in the
+  // rest pose: the pairs a fitted pose must not push through each other.
+  std::vector<std::pair<int, int>> collision_pairs;
 
   int num_hinges() const { return static_cast<int>(hinge_low_rad.size()); }
   int num_keypoints() const { return static_cast<int>(keypoints.size()); }
@@ -252,6 +268,17 @@ void CharacterPointsWithJacobian(const KinematicModel& model,
                                  const double* root_quaternion_wxyz,
                                  const double* hinges_rad, double* points_m,
                                  double* jacobian);
+
+// World positions of `points` (3 numbers each) into `points_m` and, when
+// `jacobian` is not null, their derivatives with respect to the pose
+// (row-major: 3 x points rows, PoseJacobianColumns columns), as
+// CharacterPointsWithJacobian computes them.
+void BodyPointsWithJacobian(const KinematicModel& model,
+                            const double* root_position_m,
+                            const double* root_quaternion_wxyz,
+                            const double* hinges_rad,
+                            const std::vector<BodyPoint>& points,
+                            double* points_m, double* jacobian);
 
 // The whole body's centre of mass (world, m) into `com_m` (3), with its
 // derivatives with respect to the pose in `jacobian` (row-major 3 x

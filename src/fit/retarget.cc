@@ -77,11 +77,11 @@ std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
     const Character& character,
     const std::vector<std::vector<Eigen::Vector3d>>& keypoints_m,
     const RetargetOptions& options, const std::string& source,
-    RetargetSummary* summary) {
+    RetargetSummary* summary, const std::vector<Eigen::VectorXd>* starts_rad) {
   // Outline: check the points; scale them to the character's limb lengths;
   // per frame, place the root by the torso (a similarity fit of shoulders
   // and hips) and solve for the root and hinges, warm-started from the
-  // previous frame.
+  // previous frame or the given start.
   const KinematicModel model = KinematicModel::FromCharacter(character);
   const KeypointLayout& layout = character.keypoint_layout();
   const int num_keypoints = model.num_keypoints();
@@ -96,6 +96,19 @@ std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
     }
   }
   if (keypoints_m.empty()) throw InputError(source, "no frames to retarget");
+  if (starts_rad != nullptr) {
+    bool shaped = starts_rad->size() == keypoints_m.size();
+    for (const Eigen::VectorXd& start : *starts_rad)
+      shaped =
+          shaped && start.size() == model.num_hinges() && start.allFinite();
+    if (!shaped) {
+      throw InputError(source, "retarget starts: need " +
+                                   std::to_string(keypoints_m.size()) +
+                                   " frames of " +
+                                   std::to_string(model.num_hinges()) +
+                                   " finite hinge angles");
+    }
+  }
 
   std::vector<double> rest(model.num_hinges());
   for (int h = 0; h < model.num_hinges(); ++h)
@@ -132,7 +145,14 @@ std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
   std::vector<double> hinges = rest;
   std::vector<double> previous;
   double error_sum = 0.0, worst = 0.0;
+  std::vector<double> frame_mean_m, frame_worst_m;
   for (size_t t = 0; t < keypoints_m.size(); ++t) {
+    if (starts_rad != nullptr) {
+      for (int h = 0; h < model.num_hinges(); ++h) {
+        hinges[h] = std::clamp((*starts_rad)[t][h], model.hinge_low_rad[h],
+                               model.hinge_high_rad[h]);
+      }
+    }
     std::vector<Eigen::Vector3d> targets;
     for (const Eigen::Vector3d& p : keypoints_m[t])
       targets.push_back(scale * p);
@@ -173,14 +193,18 @@ std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
 
     const std::vector<Eigen::Vector3d> placed =
         PointsOf(model, root, quaternion, hinges.data());
-    double frame_error = 0.0;
+    double frame_error = 0.0, frame_worst = 0.0;
     int counted = 0;
     for (int j = 0; j < num_keypoints; ++j) {
       if (weights[j] < 1.0) continue;
-      frame_error += (placed[j] - targets[j]).norm();
+      const double distance_m = (placed[j] - targets[j]).norm();
+      frame_error += distance_m;
+      frame_worst = std::max(frame_worst, distance_m);
       ++counted;
     }
     frame_error /= counted;
+    frame_mean_m.push_back(frame_error);
+    frame_worst_m.push_back(frame_worst);
     error_sum += frame_error;
     worst = std::max(worst, frame_error);
     result.push_back(
@@ -192,6 +216,8 @@ std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
     summary->scale = scale;
     summary->mean_error_m = error_sum / keypoints_m.size();
     summary->worst_frame_error_m = worst;
+    summary->frame_mean_error_m = std::move(frame_mean_m);
+    summary->frame_worst_error_m = std::move(frame_worst_m);
   }
   return result;
 }

@@ -32,18 +32,26 @@ struct RetargetSummary {
   double scale = 1.0;         // applied to the source keypoints
   double mean_error_m = 0.0;  // body keypoints, after scaling
   double worst_frame_error_m = 0.0;
+  // Per frame, over the body keypoints (the face's are approximate): the
+  // mean and the largest distance of a placed keypoint to its target (m).
+  std::vector<double> frame_mean_error_m;
+  std::vector<double> frame_worst_error_m;
 };
 
 // Hinge angles (rad, action order, within their ranges) per frame that
 // place the character's COCO-17 keypoints on `keypoints_m` (per frame, in
 // layout order, metres, z up), scaled first by the ratio of the
-// character's limb lengths to the source's (median over frames). InputError
-// naming `source` for a frame without 17 finite points.
+// character's limb lengths to the source's (median over frames). Each frame
+// starts from the previous frame's solution, or from `starts_rad` (per
+// frame, action order, clamped into the ranges) when given. InputError
+// naming `source` for a frame without 17 finite points or starts of the
+// wrong shape.
 std::vector<Eigen::VectorXd> RetargetKeypointsToHinges(
     const Character& character,
     const std::vector<std::vector<Eigen::Vector3d>>& keypoints_m,
     const RetargetOptions& options, const std::string& source,
-    RetargetSummary* summary = nullptr);
+    RetargetSummary* summary = nullptr,
+    const std::vector<Eigen::VectorXd>* starts_rad = nullptr);
 
 }  // namespace m2d
 

@@ -1,7 +1,8 @@
 // tests: the inverse-dynamics feasibility of a reference motion
 // (eval/motion_feasibility.h): standing, a ballistic flight and a hover, an
-// arm swung slowly and too fast, and the DeepMimic walk at its own pace and
-// five times faster, under either reading of the torque limits.
+// arm swung slowly and too fast, a knee bent past its range, limbs folded
+// through the body, and the DeepMimic walk at its own pace and five times
+// faster, under either reading of the torque limits.
 #include "eval/motion_feasibility.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "common/error.h"
@@ -81,6 +83,9 @@ TEST(MotionFeasibility, StandingStillTakesTheBodyWeightFromTheFloor) {
   EXPECT_EQ(result.AirborneFrames(), 0);
   EXPECT_EQ(result.FramesFloorCannotExplain(), 0);
   EXPECT_EQ(result.FramesOverTorqueLimit(), 0);
+  EXPECT_EQ(result.FramesOutOfRange(), 0);
+  EXPECT_EQ(result.FramesSelfPenetrating(), 0);
+  EXPECT_EQ(result.DeepestSelfPenetration(), nullptr);
   for (const FrameDemand& frame : result.frames) {
     EXPECT_NEAR(frame.external_force_n.z(), result.body_weight_n,
                 1e-6 * result.body_weight_n);
@@ -150,6 +155,68 @@ TEST(MotionFeasibility, AnArmSwungTooFastIsOverItsTorqueLimit) {
   EXPECT_GT(fast.FramesOverTorqueLimit(), 20);
   EXPECT_EQ(fast.frames[10].worst_hinge, shoulder);
   EXPECT_NE(fast.BriefReport().find("right_shoulder_y"), std::string::npos);
+}
+
+TEST(MotionFeasibility, AKneeBentBackwardsIsOutOfItsRange) {
+  auto character = Humanoid();
+  const int knee = HingeOfActuator(*character, "right_knee");
+  // The knee's range is 0-160 degrees; from frame 5 on it is bent 0.5 rad
+  // the wrong way, which no solution of the rotation puts in range.
+  std::vector<double> qpos = StandingQpos(character);
+  std::vector<Pose3D> poses;
+  for (int t = 0; t < 10; ++t) {
+    qpos[character->hinges()[knee].qpos_address] = t < 5 ? 0.3 : -0.5;
+    poses.push_back(QposToPose(*character, qpos.data()));
+  }
+  const MotionFeasibility result =
+      MeasureMotionFeasibility(*character, poses, kFps, FeasibilityOptions());
+  EXPECT_EQ(result.FramesOutOfRange(), 5);
+  EXPECT_EQ(result.hinges[knee].frames_out_of_range, 5);
+  EXPECT_NEAR(result.hinges[knee].peak_range_excess_rad, 0.5, 1e-6);
+  EXPECT_EQ(result.hinges[knee].peak_range_frame, 5);
+  EXPECT_EQ(result.frames[4].worst_range_hinge, -1);
+  EXPECT_EQ(result.frames[7].worst_range_hinge, knee);
+  EXPECT_EQ(result.WorstRangeHinge(), &result.hinges[knee]);
+  EXPECT_NE(result.BriefReport().find("out of a joint range: 5 frames"),
+            std::string::npos)
+      << result.BriefReport();
+
+  // Within the tolerance (recorded motion resting on a range's end) it is
+  // not counted, though the excess is kept.
+  FeasibilityOptions tolerant;
+  tolerant.range_tolerance_rad = 0.6;
+  EXPECT_EQ(MeasureMotionFeasibility(*character, poses, kFps, tolerant)
+                .FramesOutOfRange(),
+            0);
+}
+
+// Random angles within the ranges fold limbs through each other and the
+// trunk: the self-overlap is found and its geoms named.
+TEST(MotionFeasibility, LimbsFoldedThroughTheBodyOverlapIt) {
+  auto character = Humanoid();
+  std::vector<double> qpos = StandingQpos(character);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Pose3D> poses;
+  for (int t = 0; t < 20; ++t) {
+    for (const ActuatedHinge& hinge : character->hinges()) {
+      qpos[hinge.qpos_address] =
+          hinge.range_low_rad +
+          unit(rng) * (hinge.range_high_rad - hinge.range_low_rad);
+    }
+    qpos[character->root_qpos_address() + 2] = 1.5;  // clear of the floor
+    poses.push_back(QposToPose(*character, qpos.data()));
+  }
+  const MotionFeasibility result =
+      MeasureMotionFeasibility(*character, poses, kFps, FeasibilityOptions());
+  EXPECT_GT(result.FramesSelfPenetrating(), 3);
+  const FrameDemand* deepest = result.DeepestSelfPenetration();
+  ASSERT_NE(deepest, nullptr);
+  EXPECT_GT(deepest->self_penetration_m, 0.02);
+  EXPECT_NE(deepest->self_contact.find('/'), std::string::npos);
+  EXPECT_NE(result.BriefReport().find("self-penetrating"), std::string::npos);
+  // Within their ranges every frame is in reach.
+  EXPECT_EQ(result.FramesOutOfReach(), 0);
 }
 
 // The largest peak torque / limit over the measured hinges.

@@ -12,15 +12,18 @@
 # (default runs/dataset, scripts/make_dataset.sh). STARTS=estimate evaluates
 # from the fit's starts and cameras instead (runs/dataset/run.json; the
 # table's protocol, for the 2D trials; the windows' columns are then the
-# fit's). Eval JSONs are cached in the run folder, per STARTS.
+# fit's). CLIP names another of the dataset's clips (default run; the
+# clip-alone trials, docs/experiments/clip_alone). Eval JSONs are cached in
+# the run folder, per STARTS.
 set -euo pipefail
 mimic2d=${MIMIC2D:-build/mimic2d}
 data=${DATA:-runs/dataset}
 starts=${STARTS:-truth}
+clip=${CLIP:-run}
 run=$1
 case $starts in
-  truth) args=(--bundle "$data/run_truth.json" --starts truth --cameras truth) ;;
-  estimate) args=(--bundle "$data/run.json" --starts estimate --cameras estimate) ;;
+  truth) args=(--bundle "$data/${clip}_truth.json" --starts truth --cameras truth) ;;
+  estimate) args=(--bundle "$data/${clip}.json" --starts estimate --cameras estimate) ;;
   *) echo "eval_curve_3d: STARTS must be truth or estimate, not $starts" >&2; exit 2 ;;
 esac
 
