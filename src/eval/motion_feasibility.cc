@@ -219,8 +219,7 @@ void MeasureReach(const Character& character, const std::vector<Pose3D>& poses,
   const KinematicModel model = KinematicModel::FromCharacter(character);
   const int num_hinges = model.num_hinges();
   std::vector<double> qpos(character.model()->nq);
-  std::vector<double> points(3 *
-                             (model.num_keypoints() + model.num_sole_points()));
+  std::vector<double> points(3 * model.num_keypoints());
   std::vector<std::vector<Eigen::Vector3d>> keypoints_m;
   std::vector<Eigen::VectorXd> starts_rad;
   std::vector<int> frames_to_fit;
@@ -231,7 +230,8 @@ void MeasureReach(const Character& character, const std::vector<Pose3D>& poses,
     for (int h = 0; h < num_hinges; ++h)
       hinges[h] = qpos[character.hinges()[h].qpos_address];
     const double* root = qpos.data() + character.root_qpos_address();
-    CharacterPoints(model, root, root + 3, hinges.data(), points.data());
+    BodyPointsWithJacobian(model, root, root + 3, hinges.data(),
+                           model.keypoints, points.data(), nullptr);
     std::vector<Eigen::Vector3d> frame_points;
     for (int j = 0; j < model.num_keypoints(); ++j)
       frame_points.emplace_back(points[3 * j], points[3 * j + 1],

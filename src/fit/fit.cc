@@ -700,21 +700,12 @@ void AddMeanBalance(const KinematicModel& model, double weight, double window_s,
 std::vector<std::pair<int, int>> NearSpherePairs(const KinematicModel& model,
                                                  const Parameters& params,
                                                  int t, double margin_m) {
-  std::vector<BodyPoint> centres;
-  for (const CollisionSphere& sphere : model.collision_spheres)
-    centres.push_back(sphere.centre);
-  std::vector<double> points(3 * centres.size());
-  BodyPointsWithJacobian(
+  const std::vector<double> centres_m = CollisionSphereCentres(
       model, params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-      params.hinges_rad[t].data(), centres, points.data(), nullptr);
+      params.hinges_rad[t].data());
   std::vector<std::pair<int, int>> near;
   for (const auto& [a, b] : model.collision_pairs) {
-    const double gap_m = (Eigen::Map<const Eigen::Vector3d>(&points[3 * a]) -
-                          Eigen::Map<const Eigen::Vector3d>(&points[3 * b]))
-                             .norm() -
-                         model.collision_spheres[a].radius_m -
-                         model.collision_spheres[b].radius_m;
-    if (gap_m < margin_m) near.push_back({a, b});
+    if (SphereGapM(model, centres_m, a, b) < margin_m) near.push_back({a, b});
   }
   return near;
 }

@@ -223,23 +223,16 @@ void AddCollisionSpheres(const Character& character, KinematicModel* model) {
         std::clamp(0.0, model->hinge_low_rad[h], model->hinge_high_rad[h]);
   const double origin[3] = {0, 0, 0};
   const double identity[4] = {1, 0, 0, 0};
-  std::vector<BodyPoint> centres;
-  for (const CollisionSphere& sphere : model->collision_spheres)
-    centres.push_back(sphere.centre);
-  std::vector<double> at_rest(3 * centres.size());
-  BodyPointsWithJacobian(*model, origin, identity, rest.data(), centres,
-                         at_rest.data(), nullptr);
-  const int num_spheres = static_cast<int>(centres.size());
+  const std::vector<double> at_rest =
+      CollisionSphereCentres(*model, origin, identity, rest.data());
+  const int num_spheres = static_cast<int>(model->collision_spheres.size());
   for (int a = 0; a < num_spheres; ++a) {
     for (int b = a + 1; b < num_spheres; ++b) {
-      const CollisionSphere& sa = model->collision_spheres[a];
-      const CollisionSphere& sb = model->collision_spheres[b];
-      if (!MayCollide(m, sa.geom, sb.geom)) continue;
-      const double distance_m =
-          (Eigen::Map<const Eigen::Vector3d>(&at_rest[3 * a]) -
-           Eigen::Map<const Eigen::Vector3d>(&at_rest[3 * b]))
-              .norm();
-      if (distance_m <= sa.radius_m + sb.radius_m) continue;
+      if (!MayCollide(m, model->collision_spheres[a].geom,
+                      model->collision_spheres[b].geom) ||
+          SphereGapM(*model, at_rest, a, b) <= 0.0) {
+        continue;
+      }
       model->collision_pairs.push_back({a, b});
     }
   }
@@ -320,6 +313,28 @@ void BodyPointsWithJacobian(const KinematicModel& model,
     const Eigen::Vector3d world = context.AddPoint(points[p], 1.0, rows);
     for (int c = 0; c < 3; ++c) points_m[3 * p + c] = world[c];
   }
+}
+
+std::vector<double> CollisionSphereCentres(const KinematicModel& model,
+                                           const double* root_position_m,
+                                           const double* root_quaternion_wxyz,
+                                           const double* hinges_rad) {
+  std::vector<BodyPoint> centres;
+  for (const CollisionSphere& sphere : model.collision_spheres)
+    centres.push_back(sphere.centre);
+  std::vector<double> centres_m(3 * centres.size());
+  BodyPointsWithJacobian(model, root_position_m, root_quaternion_wxyz,
+                         hinges_rad, centres, centres_m.data(), nullptr);
+  return centres_m;
+}
+
+double SphereGapM(const KinematicModel& model,
+                  const std::vector<double>& centres_m, int a, int b) {
+  return (Eigen::Map<const Eigen::Vector3d>(&centres_m[3 * a]) -
+          Eigen::Map<const Eigen::Vector3d>(&centres_m[3 * b]))
+             .norm() -
+         model.collision_spheres[a].radius_m -
+         model.collision_spheres[b].radius_m;
 }
 
 void CenterOfMassWithJacobian(const KinematicModel& model,

@@ -280,6 +280,19 @@ void BodyPointsWithJacobian(const KinematicModel& model,
                             const std::vector<BodyPoint>& points,
                             double* points_m, double* jacobian);
 
+// The world centres of `model`'s collision spheres for one pose, 3 numbers
+// each in collision_spheres order.
+std::vector<double> CollisionSphereCentres(const KinematicModel& model,
+                                           const double* root_position_m,
+                                           const double* root_quaternion_wxyz,
+                                           const double* hinges_rad);
+
+// The gap between the surfaces of collision spheres `a` and `b` (m;
+// negative where they overlap), their centres as CollisionSphereCentres
+// gives them.
+double SphereGapM(const KinematicModel& model,
+                  const std::vector<double>& centres_m, int a, int b);
+
 // The whole body's centre of mass (world, m) into `com_m` (3), with its
 // derivatives with respect to the pose in `jacobian` (row-major 3 x
 // PoseJacobianColumns; null: none): the mass-weighted mean of the bodies'

@@ -144,9 +144,6 @@ TEST(FitKinematics, CollisionSpheresAreInsideMujocosGeoms) {
     EXPECT_NE(mj->body_parentid[body_i], body_j);
     EXPECT_NE(mj->body_parentid[body_j], body_i);
   }
-  std::vector<BodyPoint> centres;
-  for (const CollisionSphere& sphere : model.collision_spheres)
-    centres.push_back(sphere.centre);
   Simulation simulation(character, SimulationOptions());
   mjData* data = simulation.mutable_data();
   std::mt19937_64 rng(11);
@@ -156,11 +153,10 @@ TEST(FitKinematics, CollisionSpheresAreInsideMujocosGeoms) {
     simulation.SetPose(FittedPose(*character, pose.root_m.data(),
                                   pose.quaternion_wxyz.data(),
                                   pose.hinges_rad.data()));
-    std::vector<double> points(3 * centres.size());
-    BodyPointsWithJacobian(model, pose.root_m.data(),
-                           pose.quaternion_wxyz.data(), pose.hinges_rad.data(),
-                           centres, points.data(), nullptr);
-    for (size_t s = 0; s < centres.size(); ++s) {
+    const std::vector<double> points = CollisionSphereCentres(
+        model, pose.root_m.data(), pose.quaternion_wxyz.data(),
+        pose.hinges_rad.data());
+    for (size_t s = 0; s < model.collision_spheres.size(); ++s) {
       const CollisionSphere& sphere = model.collision_spheres[s];
       const int g = sphere.geom;
       const Eigen::Vector3d centre(points.data() + 3 * s);
@@ -185,10 +181,7 @@ TEST(FitKinematics, CollisionSpheresAreInsideMujocosGeoms) {
     for (const auto& [i, j] : model.collision_pairs) {
       const CollisionSphere& si = model.collision_spheres[i];
       const CollisionSphere& sj = model.collision_spheres[j];
-      const double overlap_m = si.radius_m + sj.radius_m -
-                               (Eigen::Map<Eigen::Vector3d>(&points[3 * i]) -
-                                Eigen::Map<Eigen::Vector3d>(&points[3 * j]))
-                                   .norm();
+      const double overlap_m = -SphereGapM(model, points, i, j);
       if (overlap_m < 0.01) continue;
       ++overlaps;
       double deepest_m = -1.0;
@@ -390,21 +383,12 @@ TEST(FitCosts, EveryTermsJacobianMatchesFiniteDifferences) {
   self_contact.model = &model;
   self_contact.weight = 50.0;
   {
-    std::vector<BodyPoint> centres;
-    for (const CollisionSphere& sphere : model.collision_spheres)
-      centres.push_back(sphere.centre);
-    std::vector<double> points(3 * centres.size());
-    BodyPointsWithJacobian(model, a.root_m.data(), a.quaternion_wxyz.data(),
-                           a.hinges_rad.data(), centres, points.data(),
-                           nullptr);
+    const std::vector<double> centres_m = CollisionSphereCentres(
+        model, a.root_m.data(), a.quaternion_wxyz.data(), a.hinges_rad.data());
     for (const auto& [i, j] : model.collision_pairs) {
-      const double overlap_m = model.collision_spheres[i].radius_m +
-                               model.collision_spheres[j].radius_m -
-                               (Eigen::Map<Eigen::Vector3d>(&points[3 * i]) -
-                                Eigen::Map<Eigen::Vector3d>(&points[3 * j]))
-                                   .norm();
       // Clear of the kink at 0, where the residual is not differentiable.
-      if (overlap_m > 0.005) self_contact.pairs.push_back({i, j});
+      if (-SphereGapM(model, centres_m, i, j) > 0.005)
+        self_contact.pairs.push_back({i, j});
     }
   }
   ASSERT_FALSE(self_contact.pairs.empty());
