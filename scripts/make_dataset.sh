@@ -5,7 +5,11 @@
 # stripped to their 2D and fitted view by view: what a user with four
 # calibrated videos per clip has (the intrinsics known, `--focal`).
 #
-#   scripts/make_dataset.sh [OUT_DIR [FIT_CONFIG]]   (default runs/dataset)
+#   scripts/make_dataset.sh [--rig] [OUT_DIR [FIT_CONFIG]]   (default runs/dataset)
+#
+# --rig: each clip's four views fitted as one synchronized rig (`fit --rig`:
+# one body, the cameras placed in one world; docs/fit.md, "A rig") instead
+# of view by view. MAKE_DATASET_JOBS: fits at a time (default 2).
 #
 # FIT_CONFIG: FitOptions as YAML for every fit (docs/fit.md, "Settings");
 # default: the fit's defaults.
@@ -22,6 +26,9 @@
 # $MIMIC2D_SHARED_DATA (default ../shared/data)/deepmimic/motions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+rig=()
+if [ "${1:-}" = --rig ]; then rig=(--rig); shift; fi
+parallel=${MAKE_DATASET_JOBS:-2}
 out=${1:-runs/dataset}
 fit_config=()
 if [ -n "${2:-}" ]; then
@@ -66,7 +73,7 @@ make_one() {  # clip index [noisy]
       > /dev/null
   fi
   if $bin fit "$out/${name}_2d.json" --camera static --focal 1400 --quiet \
-    "${fit_config[@]}" --truth "$out/${name}_truth.json" \
+    "${rig[@]}" "${fit_config[@]}" --truth "$out/${name}_truth.json" \
     -o "$out/${name}.json" > "$out/${name}_fit.log" 2>&1; then
     echo "fitted $name"
   else
@@ -75,7 +82,7 @@ make_one() {  # clip index [noisy]
   fi
 }
 
-# Two fits at a time (one solver thread each).
+# $parallel fits at a time (one solver thread each).
 jobs_started=0
 for variant in clean noisy; do
   index=0
@@ -83,7 +90,7 @@ for variant in clean noisy; do
     make_one "$clip" "$index" "$variant" &
     index=$((index + 1))
     jobs_started=$((jobs_started + 1))
-    if (( jobs_started % 2 == 0 )); then wait; fi
+    if (( jobs_started % parallel == 0 )); then wait; fi
   done
 done
 wait

@@ -32,6 +32,7 @@ struct FitArgs {
   std::string truth;
   FitOptions options;
   bool quiet = false;
+  bool rig = false;  // the views are one synchronized take (FitRig)
 };
 
 int RunFit(FitArgs& args) {
@@ -77,13 +78,15 @@ int RunFit(FitArgs& args) {
   const std::string character_path = AssetArgumentPath(args.character);
   auto character =
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
-  std::printf("fitting %zu view(s) of %s (%d frames), camera %s, focal %s\n",
+  std::printf("fitting %zu view(s) of %s (%d frames)%s, camera %s, focal %s\n",
               bundle.views.size(), args.input.c_str(), bundle.num_frames(),
+              args.rig ? " as one rig" : "",
               CameraMotionName(args.options.camera_motion),
               args.options.fixed_focal_px > 0 ? "fixed" : "estimated");
   int failed_views = 0;
   std::vector<FitAccuracy> accuracies;
-  ReferenceBundle fitted = FitBundle(
+  const auto fit_views = args.rig ? FitRig : FitBundle;
+  ReferenceBundle fitted = fit_views(
       bundle, *character, args.options, args.input,
       [&](int view, const ViewEstimate& estimate) {
         const FitSummary& summary = estimate.summary;
@@ -167,6 +170,10 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
   fit->add_option("--threads", args->threads, "solver threads (default 1)")
       ->check(CLI::PositiveNumber);
   fit->add_flag("--quiet", args->quiet, "no per-stage progress lines");
+  fit->add_flag("--rig", args->rig,
+                "the views are one synchronized take of static cameras (a "
+                "calibrated rig): one body fitted to all of them, each "
+                "camera placed in one world (docs/fit.md, \"A rig\")");
   fit->add_option("--truth", args->truth,
                   "bundle holding the input's 3D truth and true cameras (a "
                   "stripped bundle's original): each view's fit is measured "

@@ -89,13 +89,20 @@ std::vector<EvalRow> EvaluatePolicy(
   }
   // Global positions compare only in the true cameras' world.
   const bool same_world = reference->sources().cameras == CameraSource::kTruth;
-  // K views of one motion must share a world: each view's estimated camera
-  // lives in its own.
-  if (options.num_views > 1 && !same_world) {
+  // K views of one motion must share a world: the true cameras, or a rig's
+  // estimate (`fit --rig`); a view fitted alone lives in its own.
+  bool views_share_world = same_world;
+  if (reference->sources().cameras == CameraSource::kEstimate) {
+    views_share_world = true;
+    for (const ReferenceBundle& bundle : reference->bundles())
+      views_share_world = views_share_world && bundle.estimate_one_world;
+  }
+  if (options.num_views > 1 && !views_share_world) {
     throw ConfigError(
         "eval: tracking " + std::to_string(options.num_views) +
         " views at once needs their cameras in one world: the true cameras "
-        "(a calibrated rig; --cameras truth), not per-view estimates");
+        "(a calibrated rig; --cameras truth) or a rig's estimate (`mimic2d "
+        "fit --rig`), not views fitted alone");
   }
   const std::vector<std::vector<int>> view_sets =
       ViewSets(*reference, options.num_views);

@@ -2,7 +2,8 @@
 // principal point at the image centre; orientation = pitch (positive looks
 // down) and roll about the optical axis, yaw fixed at 0 (the world heading is
 // free, so the camera's yaw defines it: it looks along +x); centre above the
-// ground plane z = 0.
+// ground plane z = 0. A rig's other cameras (FitRig) add a yaw: the heading
+// they look along, from +x toward +y.
 #ifndef MIMIC2D_FIT_CAMERA_MODEL_H_
 #define MIMIC2D_FIT_CAMERA_MODEL_H_
 
@@ -31,6 +32,19 @@ Eigen::Matrix<T, 3, 3> FitCameraRotation(const T* pitch_roll_rad) {
   return roll * pitch * level;
 }
 
+// The same camera turned by `yaw_rad` about the world's z: it looks along
+// (cos yaw, sin yaw) at pitch 0.
+template <typename T>
+Eigen::Matrix<T, 3, 3> FitCameraRotation(const T* pitch_roll_rad,
+                                         const T& yaw_rad) {
+  using std::cos;
+  using std::sin;
+  const T cy = cos(yaw_rad), sy = sin(yaw_rad);
+  Eigen::Matrix<T, 3, 3> unturn;  // world to the camera's heading frame
+  unturn << cy, sy, T(0), -sy, cy, T(0), T(0), T(0), T(1);
+  return FitCameraRotation(pitch_roll_rad) * unturn;
+}
+
 // Depth below which a point is treated as this far in front (keeps the
 // projection finite while a solver step passes through the camera plane).
 inline constexpr double kFitMinDepth_m = 0.05;
@@ -51,14 +65,33 @@ void FitProject(const T& focal_px, const T* pitch_roll_rad, const T* centre_m,
   pixel_px[1] = focal_px * camera.y() / depth + T(cy_px);
 }
 
+// The same for a camera turned by `yaw_rad` (FitCameraRotation above): the
+// point and the centre seen in the camera's heading frame.
+template <typename T>
+void FitProjectTurned(const T& focal_px, const T* pitch_roll_rad,
+                      const T& yaw_rad, const T* centre_m, const T* point_m,
+                      double cx_px, double cy_px, T* pixel_px) {
+  using std::cos;
+  using std::sin;
+  const T cy = cos(yaw_rad), sy = sin(yaw_rad);
+  const T centre[3] = {cy * centre_m[0] + sy * centre_m[1],
+                       -sy * centre_m[0] + cy * centre_m[1], centre_m[2]};
+  const T point[3] = {cy * point_m[0] + sy * point_m[1],
+                      -sy * point_m[0] + cy * point_m[1], point_m[2]};
+  FitProject(focal_px, pitch_roll_rad, centre, point, cx_px, cy_px, pixel_px);
+}
+
 // The estimated camera as a PinholeCamera for an image of the given size.
 PinholeCamera ToPinholeCamera(double focal_px, const double* pitch_roll_rad,
                               const double* centre_m, int width_px,
-                              int height_px);
+                              int height_px, double yaw_rad = 0.0);
 
 // Pitch (positive looks down) and roll of any camera, in radians, by the
 // convention above: for measuring a fit against a true camera.
 Eigen::Vector2d CameraPitchRollRad(const PinholeCamera& camera);
+
+// The heading (rad, from +x toward +y) the camera looks along.
+double CameraYawRad(const PinholeCamera& camera);
 
 }  // namespace m2d
 

@@ -123,31 +123,40 @@ bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
   // projection with its derivatives in the camera and the point (Jets),
   // chained through the robust residual; the floor, penetration and upright
   // rows. Jacobian rows start at zero and terms add into them.
-  using Jet9 = ceres::Jet<double, 9>;
+  using Jet10 = ceres::Jet<double, 10>;
   using Jet4 = ceres::Jet<double, 4>;
   const int num_keypoints = model->num_keypoints();
   const int num_soles = model->num_sole_points();
   const int num_hinges = model->num_hinges();
   const bool want = jacobians != nullptr;
-  ZeroJacobians(jacobians, FrameBlockSizes(*model), NumResiduals(*model));
-  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5], want);
+  ZeroJacobians(jacobians, BlockSizes(), NumResiduals(*model));
+  // The pose's Jacobian only when a pose block is free (a rig camera's
+  // placement holds the body).
+  const bool want_pose = want && (jacobians[3] || jacobians[4] || jacobians[5]);
+  const PosedPoints posed(*model, blocks[3], blocks[4], blocks[5], want_pose);
   double* const no_pose[3] = {nullptr, nullptr, nullptr};
-  double* const* pose_jacobians = want ? jacobians + 3 : no_pose;
+  double* const* pose_jacobians = want_pose ? jacobians + 3 : no_pose;
 
   // Reprojection: residual rows 2j, 2j + 1.
-  const Jet9 focal(blocks[0][0], 0);
-  const Jet9 pitch_roll[2] = {Jet9(blocks[1][0], 1), Jet9(blocks[1][1], 2)};
-  const Jet9 centre[3] = {Jet9(blocks[2][0], 3), Jet9(blocks[2][1], 4),
-                          Jet9(blocks[2][2], 5)};
+  const Jet10 focal(blocks[0][0], 0);
+  const Jet10 pitch_roll[2] = {Jet10(blocks[1][0], 1), Jet10(blocks[1][1], 2)};
+  const Jet10 centre[3] = {Jet10(blocks[2][0], 3), Jet10(blocks[2][1], 4),
+                           Jet10(blocks[2][2], 5)};
+  const Jet10 yaw = camera_yaw ? Jet10(blocks[6][0], 9) : Jet10(0.0);
   for (int j = 0; j < num_keypoints; ++j) {
     if (weights[j] == 0.0) {
       residuals[2 * j] = residuals[2 * j + 1] = 0.0;
       continue;
     }
     const double* p = &posed.points[3 * j];
-    const Jet9 point[3] = {Jet9(p[0], 6), Jet9(p[1], 7), Jet9(p[2], 8)};
-    Jet9 pixel[2];
-    FitProject(focal, pitch_roll, centre, point, cx_px, cy_px, pixel);
+    const Jet10 point[3] = {Jet10(p[0], 6), Jet10(p[1], 7), Jet10(p[2], 8)};
+    Jet10 pixel[2];
+    if (camera_yaw) {
+      FitProjectTurned(focal, pitch_roll, yaw, centre, point, cx_px, cy_px,
+                       pixel);
+    } else {
+      FitProject(focal, pitch_roll, centre, point, cx_px, cy_px, pixel);
+    }
     for (int k = 0; k < 2; ++k) {
       const int row = 2 * j + k;
       const auto [value, slope] = ValueAndSlope(
@@ -156,7 +165,7 @@ bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
       residuals[row] = weights[j] * value;
       if (!want) continue;
       const double d_pixel = weights[j] * slope * inv_scale_px;
-      const Eigen::Matrix<double, 9, 1>& d = pixel[k].v;
+      const Eigen::Matrix<double, 10, 1>& d = pixel[k].v;
       if (jacobians[0]) jacobians[0][row] = d_pixel * d[0];
       if (jacobians[1]) {
         for (int c = 0; c < 2; ++c)
@@ -166,6 +175,7 @@ bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
         for (int c = 0; c < 3; ++c)
           jacobians[2][3 * row + c] = d_pixel * d[3 + c];
       }
+      if (camera_yaw && jacobians[6]) jacobians[6][row] = d_pixel * d[9];
       const double gradient[3] = {d[6], d[7], d[8]};
       posed.AddPoseRow(j, gradient, row, d_pixel, pose_jacobians, num_hinges);
     }
@@ -214,8 +224,14 @@ bool FrameCost::Evaluate(double const* const* blocks, double* residuals,
   return true;
 }
 
+std::vector<int32_t> FrameCost::BlockSizes() const {
+  std::vector<int32_t> sizes = FrameBlockSizes(*model);
+  if (camera_yaw) sizes.push_back(1);
+  return sizes;
+}
+
 ceres::CostFunction* FrameCost::Create(FrameCost cost) {
-  const std::vector<int32_t> sizes = FrameBlockSizes(*cost.model);
+  const std::vector<int32_t> sizes = cost.BlockSizes();
   const int num_residuals = NumResiduals(*cost.model);
   return new AnalyticCostFunction<FrameCost>(std::move(cost), sizes,
                                              num_residuals);

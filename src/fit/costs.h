@@ -37,6 +37,9 @@ T GemanMcClureResidual(const T& x, double sigma) {
 //  - penetration, 1 per sole point: its height when below z = 0;
 //  - upright, 2: the horizontal part of the root's up axis (people stand
 //    upright on average; it keeps camera roll from hiding in a lean).
+// With `camera_yaw` a seventh block, the camera's yaw (1): a rig's other
+// cameras (FitRig), whose terms beyond the reprojection are weighted 0 (the
+// body's are counted once, with the first camera).
 struct FrameCost {
   const KinematicModel* model;
   std::vector<Eigen::Vector2d> observed_px;  // per keypoint
@@ -48,6 +51,7 @@ struct FrameCost {
   double penetration_weight = 0.0;
   double airborne_m = 0.15;
   double upright_weight = 0.0;
+  bool camera_yaw = false;
 
   static int NumResiduals(const KinematicModel& model) {
     return 2 * model.num_keypoints() + 1 + model.num_sole_points() + 2;
@@ -55,9 +59,12 @@ struct FrameCost {
 
   // Residuals and, for the blocks `jacobians` asks for, their derivatives:
   // the pose's from CharacterPointsWithJacobian, the projection's through
-  // 9-wide Jets (camera and point).
+  // 10-wide Jets (camera with its yaw, and point).
   bool Evaluate(double const* const* blocks, double* residuals,
                 double** jacobians) const;
+
+  // The blocks' sizes, in the order above.
+  std::vector<int32_t> BlockSizes() const;
 
   static ceres::CostFunction* Create(FrameCost cost);
 };

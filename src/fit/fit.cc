@@ -197,15 +197,13 @@ FitPriors MakeFitPriors(const Character& character, const KinematicModel& model,
   return priors;
 }
 
-// Every estimated quantity. Vectors are sized once, so block pointers stay
-// valid while Ceres holds them.
-struct Parameters {
+// One camera's estimated quantities (camera_model.h).
+struct CameraParameters {
   double focal_px = 0.0;
   double pitch_roll_rad[2] = {0.0, 0.0};
+  // 0, the world's heading, but for a rig's other cameras (FitRig).
+  double yaw_rad = 0.0;
   std::vector<Eigen::Vector3d> centres_m;  // 1 (static) or one per frame
-  std::vector<Eigen::Vector3d> root_m;
-  std::vector<Eigen::Vector4d> quaternion_wxyz;
-  std::vector<std::vector<double>> hinges_rad;
 
   double* centre(int t) {
     return centres_m.size() == 1 ? centres_m[0].data() : centres_m[t].data();
@@ -213,6 +211,25 @@ struct Parameters {
   const double* centre(int t) const {
     return centres_m.size() == 1 ? centres_m[0].data() : centres_m[t].data();
   }
+  PinholeCamera ToPinhole(int c, const Observations& obs) const {
+    return ToPinholeCamera(focal_px, pitch_roll_rad, centres_m[c].data(),
+                           obs.width_px, obs.height_px, yaw_rad);
+  }
+};
+
+// Every estimated quantity. Vectors are sized once, so block pointers stay
+// valid while Ceres holds them.
+struct Parameters {
+  CameraParameters camera;
+  // A synchronized rig's other cameras (FitRig), seeing the same body; empty
+  // for one view.
+  std::vector<CameraParameters> rig_cameras;
+  std::vector<Eigen::Vector3d> root_m;
+  std::vector<Eigen::Vector4d> quaternion_wxyz;
+  std::vector<std::vector<double>> hinges_rad;
+
+  double* centre(int t) { return camera.centre(t); }
+  const double* centre(int t) const { return camera.centre(t); }
 };
 
 // The rest pose's keypoints (root at the origin, identity orientation, all
@@ -261,9 +278,10 @@ Parameters InitialParameters(const Observations& obs,
                              const FitOptions& options, double focal_px,
                              double yaw_rad, double pitch_rad) {
   Parameters params;
-  params.focal_px = focal_px;
-  params.pitch_roll_rad[0] = pitch_rad;
-  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
+  params.camera.focal_px = focal_px;
+  params.camera.pitch_roll_rad[0] = pitch_rad;
+  const Eigen::Matrix3d rotation =
+      FitCameraRotation(params.camera.pitch_roll_rad);
   const double cx = 0.5 * obs.width_px, cy = 0.5 * obs.height_px;
   // Each root relative to the camera centre, in the world's axes.
   std::vector<Eigen::Vector3d> from_camera_m(obs.num_frames);
@@ -280,7 +298,7 @@ Parameters InitialParameters(const Observations& obs,
   const double height_m = std::clamp(root_height_m + Median(drop_m), 0.3, 30.0);
   const int num_centres =
       options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1;
-  params.centres_m.assign(num_centres, Eigen::Vector3d(0, 0, height_m));
+  params.camera.centres_m.assign(num_centres, Eigen::Vector3d(0, 0, height_m));
   const Eigen::Quaterniond turn(
       Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()));
   for (int t = 0; t < obs.num_frames; ++t) {
@@ -394,12 +412,13 @@ double WeightedMedian(std::vector<std::pair<double, double>> value_weight) {
 bool BackProjectToPlane(const Observations& obs, const Parameters& params,
                         int t, const Eigen::Vector2d& pixel_px,
                         double plane_z_m, Eigen::Vector3d* point_m) {
-  const Eigen::Matrix3d rotation = FitCameraRotation(params.pitch_roll_rad);
+  const Eigen::Matrix3d rotation =
+      FitCameraRotation(params.camera.pitch_roll_rad);
   const Eigen::Vector3d ray =
       rotation.transpose() *
-      Eigen::Vector3d((pixel_px.x() - 0.5 * obs.width_px) / params.focal_px,
-                      (pixel_px.y() - 0.5 * obs.height_px) / params.focal_px,
-                      1.0);
+      Eigen::Vector3d(
+          (pixel_px.x() - 0.5 * obs.width_px) / params.camera.focal_px,
+          (pixel_px.y() - 0.5 * obs.height_px) / params.camera.focal_px, 1.0);
   const Eigen::Vector3d centre(params.centre(t));
   if (ray.z() > -1e-3) return false;
   const double along = (plane_z_m - centre.z()) / ray.z();
@@ -604,7 +623,7 @@ void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
   }
   for (int t = 0; t < num_frames; ++t) {
     params.root_m[t].head<2>() += shift[t];
-    params.centres_m[t].head<2>() += shift[t];
+    params.camera.centres_m[t].head<2>() += shift[t];
   }
 }
 
@@ -712,38 +731,158 @@ std::vector<std::pair<int, int>> NearSpherePairs(const KinematicModel& model,
 
 // Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
 // them out); `term_blocks` (optional) records which term each block is.
+// Frame t's reprojection term for `camera` (FrameCost), with the floor and
+// uprightness when `with_body_terms` (once per frame, with the first
+// camera); a rig's other camera (`camera.yaw_rad` a block) without.
+FrameCost MakeFrameCost(const Observations& obs, const KinematicModel& model,
+                        const FitOptions& options, const FitPriors& priors,
+                        const std::vector<double>& keypoint_mask, int t,
+                        bool with_body_terms, bool camera_yaw) {
+  FrameCost cost;
+  cost.model = &model;
+  cost.cx_px = 0.5 * obs.width_px;
+  cost.cy_px = 0.5 * obs.height_px;
+  cost.inv_scale_px = 1.0 / obs.median_scale_px;
+  cost.sigma = options.reprojection_sigma;
+  cost.camera_yaw = camera_yaw;
+  if (with_body_terms) {
+    cost.ground_weight = priors.ground_frames[t] ? options.ground_weight : 0.0;
+    cost.penetration_weight = options.penetration_weight;
+    cost.upright_weight = options.upright_weight;
+  }
+  for (int j = 0; j < obs.num_keypoints; ++j) {
+    cost.observed_px.push_back(obs.Pixel(t, j));
+    cost.weights.push_back(obs.Weight(t, j) * keypoint_mask[j]);
+  }
+  return cost;
+}
+
+// Frame t's blocks of FrameCost for `camera` (its yaw last when free).
+std::vector<double*> FrameBlocks(CameraParameters& camera, Parameters& params,
+                                 int t, bool camera_yaw) {
+  std::vector<double*> blocks = {&camera.focal_px,
+                                 camera.pitch_roll_rad,
+                                 camera.centre(t),
+                                 params.root_m[t].data(),
+                                 params.quaternion_wxyz[t].data(),
+                                 params.hinges_rad[t].data()};
+  if (camera_yaw) blocks.push_back(&camera.yaw_rad);
+  return blocks;
+}
+
+// One camera's priors and bounds: the focal fixed or free under its prior,
+// pitch and roll bounded (roll under its prior when weighted), every centre
+// above the floor under the height prior and, when it moves, slow and
+// smooth; all held in stage 4 (refine). `defines_world`: the first centre's
+// x and y are held (the world's origin is below the first camera, and its
+// heading is that camera's yaw).
+void AddCameraTerms(Stage stage, const FitOptions& options,
+                    double focal_prior_px, bool defines_world,
+                    CameraParameters& camera, ceres::Problem& problem,
+                    TermBlocks* term_blocks) {
+  // Focal: fixed, or free with a prior at the image diagonal.
+  if (problem.HasParameterBlock(&camera.focal_px)) {
+    if (options.fixed_focal_px > 0) {
+      problem.SetParameterBlockConstant(&camera.focal_px);
+    } else {
+      AddTerm(
+          problem, term_blocks, FitTerm::kFocalPrior,
+          FocalPriorCost::Create(focal_prior_px, options.focal_prior_weight),
+          {&camera.focal_px});
+      problem.SetParameterLowerBound(&camera.focal_px, 0, 0.1 * focal_prior_px);
+      problem.SetParameterUpperBound(&camera.focal_px, 0,
+                                     20.0 * focal_prior_px);
+    }
+    // Most footage is shot level (a tripod, a person holding a phone
+    // upright); without this a body's sideways lean hides in camera roll.
+    if (options.camera_roll_prior_weight > 0) {
+      AddTerm(
+          problem, term_blocks, FitTerm::kCameraRollPrior,
+          CameraRollPriorCost::Create(0.0, options.camera_roll_prior_weight),
+          {camera.pitch_roll_rad});
+    }
+    problem.SetParameterLowerBound(camera.pitch_roll_rad, 0, -1.3);
+    problem.SetParameterUpperBound(camera.pitch_roll_rad, 0, 1.3);
+    problem.SetParameterLowerBound(camera.pitch_roll_rad, 1, -0.7);
+    problem.SetParameterUpperBound(camera.pitch_roll_rad, 1, 0.7);
+  }
+  const int num_centres = static_cast<int>(camera.centres_m.size());
+  for (int c = 0; c < num_centres; ++c) {
+    double* centre = camera.centres_m[c].data();
+    if (!problem.HasParameterBlock(centre)) continue;
+    if (c == 0 && defines_world)
+      problem.SetManifold(centre, new ceres::SubsetManifold(3, {0, 1}));
+    problem.SetParameterLowerBound(centre, 2, 0.1);
+    // A person filming stands (or a tripod stands) about this high; spread
+    // over a moving camera's frames so its strength does not grow with
+    // the clip.
+    AddTerm(problem, term_blocks, FitTerm::kCameraHeightPrior,
+            CameraHeightPriorCost::Create(
+                options.camera_height_prior_m,
+                (num_centres > 1 ? options.moving_camera_height_prior_weight
+                                 : options.camera_height_prior_weight) /
+                    std::sqrt(num_centres)),
+            {centre});
+  }
+  for (int c = 1; c < num_centres; ++c) {
+    AddTerm(problem, term_blocks, FitTerm::kCameraSpeed,
+            VelocityCost::Create(options.camera_speed_weight),
+            {camera.centres_m[c - 1].data(), camera.centres_m[c].data()});
+    if (c + 1 < num_centres) {
+      AddTerm(problem, term_blocks, FitTerm::kCameraSmooth,
+              AccelerationCost::Create(3, options.camera_smooth_weight),
+              {camera.centres_m[c - 1].data(), camera.centres_m[c].data(),
+               camera.centres_m[c + 1].data()});
+    }
+  }
+  // Stage 4 refines the pose under the camera the search settled on: with
+  // the weaker smoothness the camera would drift (docs/fit.md,
+  // "Smoothness and the refinement").
+  if (stage == Stage::kRefine) {
+    for (double* block :
+         {&camera.focal_px, camera.pitch_roll_rad, &camera.yaw_rad}) {
+      if (problem.HasParameterBlock(block))
+        problem.SetParameterBlockConstant(block);
+    }
+    for (auto& centre : camera.centres_m) {
+      if (problem.HasParameterBlock(centre.data()))
+        problem.SetParameterBlockConstant(centre.data());
+    }
+  }
+}
+
+// Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
+// them out); `term_blocks` (optional) records which term each block is.
+// `rig_obs`: the views of params.rig_cameras, one each (FitRig).
 void BuildProblem(Stage stage, const Observations& obs,
                   const KinematicModel& model, const KeypointLayout& layout,
                   const FitOptions& options, const FitPriors& priors,
                   const ContactWeights* contacts, Parameters& params,
-                  ceres::Problem& problem, TermBlocks* term_blocks = nullptr) {
+                  ceres::Problem& problem, TermBlocks* term_blocks = nullptr,
+                  const std::vector<Observations>& rig_obs = {}) {
   const int num_frames = obs.num_frames;
   const int num_hinges = model.num_hinges();
-  const std::vector<double> torso = TorsoMask(layout);
-  const double sigma = options.reprojection_sigma;
+  const std::vector<double> all_keypoints(obs.num_keypoints, 1.0);
+  const std::vector<double>& keypoint_mask =
+      stage == Stage::kRoot ? TorsoMask(layout) : all_keypoints;
+  if (rig_obs.size() != params.rig_cameras.size())
+    throw std::logic_error("BuildProblem: a rig camera without its view");
 
   // Per frame: robust reprojection of the confident keypoints (none on a
-  // frame without enough), the floor, uprightness.
+  // frame without enough), the floor, uprightness; the reprojection into
+  // each of a rig's other cameras.
   for (int t = 0; t < num_frames; ++t) {
-    FrameCost cost;
-    cost.model = &model;
-    cost.cx_px = 0.5 * obs.width_px;
-    cost.cy_px = 0.5 * obs.height_px;
-    cost.inv_scale_px = 1.0 / obs.median_scale_px;
-    cost.sigma = sigma;
-    cost.ground_weight = priors.ground_frames[t] ? options.ground_weight : 0.0;
-    cost.penetration_weight = options.penetration_weight;
-    cost.upright_weight = options.upright_weight;
-    for (int j = 0; j < obs.num_keypoints; ++j) {
-      cost.observed_px.push_back(obs.Pixel(t, j));
-      cost.weights.push_back(obs.Weight(t, j) *
-                             (stage == Stage::kRoot ? torso[j] : 1.0));
-    }
     AddTerm(problem, term_blocks, FitTerm::kReprojection,
-            FrameCost::Create(std::move(cost)),
-            {&params.focal_px, params.pitch_roll_rad, params.centre(t),
-             params.root_m[t].data(), params.quaternion_wxyz[t].data(),
-             params.hinges_rad[t].data()});
+            FrameCost::Create(MakeFrameCost(obs, model, options, priors,
+                                            keypoint_mask, t, true, false)),
+            FrameBlocks(params.camera, params, t, false));
+    for (size_t k = 0; k < rig_obs.size(); ++k) {
+      AddTerm(
+          problem, term_blocks, FitTerm::kReprojection,
+          FrameCost::Create(MakeFrameCost(rig_obs[k], model, options, priors,
+                                          keypoint_mask, t, false, true)),
+          FrameBlocks(params.rig_cameras[k], params, t, true));
+    }
   }
   // Temporal smoothness of the root and of its orientation.
   for (int t = 1; t + 1 < num_frames; ++t) {
@@ -876,76 +1015,12 @@ void BuildProblem(Stage stage, const Observations& obs,
     problem.SetManifold(params.quaternion_wxyz[t].data(),
                         new ceres::QuaternionManifold());
   }
-  // The camera. Focal: fixed, or free with a prior at the image diagonal.
-  if (problem.HasParameterBlock(&params.focal_px)) {
-    if (options.fixed_focal_px > 0) {
-      problem.SetParameterBlockConstant(&params.focal_px);
-    } else {
-      AddTerm(
-          problem, term_blocks, FitTerm::kFocalPrior,
-          FocalPriorCost::Create(priors.focal_px, options.focal_prior_weight),
-          {&params.focal_px});
-      problem.SetParameterLowerBound(&params.focal_px, 0,
-                                     0.1 * priors.focal_px);
-      problem.SetParameterUpperBound(&params.focal_px, 0,
-                                     20.0 * priors.focal_px);
-    }
-    // Most footage is shot level (a tripod, a person holding a phone
-    // upright); without this a body's sideways lean hides in camera roll.
-    if (options.camera_roll_prior_weight > 0) {
-      AddTerm(
-          problem, term_blocks, FitTerm::kCameraRollPrior,
-          CameraRollPriorCost::Create(0.0, options.camera_roll_prior_weight),
-          {params.pitch_roll_rad});
-    }
-    problem.SetParameterLowerBound(params.pitch_roll_rad, 0, -1.3);
-    problem.SetParameterUpperBound(params.pitch_roll_rad, 0, 1.3);
-    problem.SetParameterLowerBound(params.pitch_roll_rad, 1, -0.7);
-    problem.SetParameterUpperBound(params.pitch_roll_rad, 1, 0.7);
-  }
-  // Centre: the world's origin is below the first camera position, so its
-  // x and y are held (the world heading is the camera's yaw, likewise).
-  const int num_centres = static_cast<int>(params.centres_m.size());
-  for (int c = 0; c < num_centres; ++c) {
-    double* centre = params.centres_m[c].data();
-    if (!problem.HasParameterBlock(centre)) continue;
-    if (c == 0)
-      problem.SetManifold(centre, new ceres::SubsetManifold(3, {0, 1}));
-    problem.SetParameterLowerBound(centre, 2, 0.1);
-    // A person filming stands (or a tripod stands) about this high; spread
-    // over a moving camera's frames so its strength does not grow with
-    // the clip.
-    AddTerm(problem, term_blocks, FitTerm::kCameraHeightPrior,
-            CameraHeightPriorCost::Create(
-                options.camera_height_prior_m,
-                (num_centres > 1 ? options.moving_camera_height_prior_weight
-                                 : options.camera_height_prior_weight) /
-                    std::sqrt(num_centres)),
-            {centre});
-  }
-  for (int c = 1; c < num_centres; ++c) {
-    AddTerm(problem, term_blocks, FitTerm::kCameraSpeed,
-            VelocityCost::Create(options.camera_speed_weight),
-            {params.centres_m[c - 1].data(), params.centres_m[c].data()});
-    if (c + 1 < num_centres) {
-      AddTerm(problem, term_blocks, FitTerm::kCameraSmooth,
-              AccelerationCost::Create(3, options.camera_smooth_weight),
-              {params.centres_m[c - 1].data(), params.centres_m[c].data(),
-               params.centres_m[c + 1].data()});
-    }
-  }
-  // Stage 4 refines the pose under the camera the search settled on: with
-  // the weaker smoothness the camera would drift (docs/fit.md,
-  // "Smoothness and the refinement").
-  if (stage == Stage::kRefine) {
-    if (problem.HasParameterBlock(&params.focal_px))
-      problem.SetParameterBlockConstant(&params.focal_px);
-    if (problem.HasParameterBlock(params.pitch_roll_rad))
-      problem.SetParameterBlockConstant(params.pitch_roll_rad);
-    for (auto& centre : params.centres_m) {
-      if (problem.HasParameterBlock(centre.data()))
-        problem.SetParameterBlockConstant(centre.data());
-    }
+  // The cameras.
+  AddCameraTerms(stage, options, priors.focal_px, true, params.camera, problem,
+                 term_blocks);
+  for (size_t k = 0; k < rig_obs.size(); ++k) {
+    AddCameraTerms(stage, options, FocalPriorPx(options, rig_obs[k]), false,
+                   params.rig_cameras[k], problem, term_blocks);
   }
 }
 
@@ -967,10 +1042,11 @@ StageResult SolveStage(Stage stage, int max_iterations, const Observations& obs,
                        const KinematicModel& model,
                        const KeypointLayout& layout, const FitOptions& options,
                        const FitPriors& priors, const ContactWeights* contacts,
-                       Parameters& params) {
+                       Parameters& params,
+                       const std::vector<Observations>& rig_obs = {}) {
   ceres::Problem problem;
   BuildProblem(stage, obs, model, layout, options, priors, contacts, params,
-               problem);
+               problem, nullptr, rig_obs);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   // Eigen's simplicial Cholesky, not CHOLMOD's supernodal one: on systems
@@ -1045,8 +1121,8 @@ void SearchLimbs(const Observations& obs, const KinematicModel& model,
       cost.hinges_rad = params.hinges_rad[t];
       std::copy_n(params.root_m[t].data(), 3, cost.root_m);
       std::copy_n(params.quaternion_wxyz[t].data(), 4, cost.quaternion_wxyz);
-      cost.focal_px = params.focal_px;
-      std::copy_n(params.pitch_roll_rad, 2, cost.pitch_roll_rad);
+      cost.focal_px = params.camera.focal_px;
+      std::copy_n(params.camera.pitch_roll_rad, 2, cost.pitch_roll_rad);
       std::copy_n(params.centre(t), 3, cost.centre_m);
       cost.cx_px = 0.5 * obs.width_px;
       cost.cy_px = 0.5 * obs.height_px;
@@ -1140,8 +1216,8 @@ void SearchLimbs(const Observations& obs, const KinematicModel& model,
 // Mean pixel distance of frame t's confident keypoints from their
 // projection; -1 when the frame has none.
 double FrameResidualPx(const Observations& obs, const KinematicModel& model,
-                       Parameters& params, int t, double* weighted_sum,
-                       double* weight_total) {
+                       const CameraParameters& camera, Parameters& params,
+                       int t, double* weighted_sum, double* weight_total) {
   std::vector<double> points(3 *
                              (model.num_keypoints() + model.num_sole_points()));
   CharacterPoints(model, params.root_m[t].data(),
@@ -1153,8 +1229,9 @@ double FrameResidualPx(const Observations& obs, const KinematicModel& model,
     const double weight = obs.Weight(t, j);
     if (weight <= 0) continue;
     double pixel[2];
-    FitProject(params.focal_px, params.pitch_roll_rad, params.centre(t),
-               &points[3 * j], 0.5 * obs.width_px, 0.5 * obs.height_px, pixel);
+    FitProjectTurned(camera.focal_px, camera.pitch_roll_rad, camera.yaw_rad,
+                     camera.centre(t), &points[3 * j], 0.5 * obs.width_px,
+                     0.5 * obs.height_px, pixel);
     const double distance =
         (Eigen::Vector2d(pixel[0], pixel[1]) - obs.Pixel(t, j)).norm();
     sum += distance;
@@ -1169,16 +1246,14 @@ double FrameResidualPx(const Observations& obs, const KinematicModel& model,
 // frame's centre for a moving camera), for progress lines.
 std::string DescribeCamera(const Parameters& params) {
   char text[128];
-  std::snprintf(text, sizeof(text),
-                "focal %.0f px, pitch %.1f deg, roll %.1f deg, height %.2f m",
-                params.focal_px, params.pitch_roll_rad[0] * 180.0 / M_PI,
-                params.pitch_roll_rad[1] * 180.0 / M_PI, params.centre(0)[2]);
+  std::snprintf(
+      text, sizeof(text),
+      "focal %.0f px, pitch %.1f deg, roll %.1f deg, height %.2f m",
+      params.camera.focal_px, params.camera.pitch_roll_rad[0] * 180.0 / M_PI,
+      params.camera.pitch_roll_rad[1] * 180.0 / M_PI, params.centre(0)[2]);
   return text;
 }
 
-// Stages 2 and 3 from `best` (the full pose, then contacts), and the
-// estimate with its account: per-frame residuals, the frames that did not
-// converge, the summary.
 // The contacts of the estimate `params`, gated by the feet standing still:
 // seen in the 2D (static camera, contacts_from_2d) or by the fitted feet's
 // speed.
@@ -1210,21 +1285,56 @@ void PlaceObjects(const Clip2D& clip, const FitOptions& options,
   }
 }
 
-ViewEstimate SolvePoseAndReport(const Observations& obs,
-                                const KinematicModel& model,
-                                const KeypointLayout& layout,
-                                const Character& character,
-                                const FitOptions& options,
-                                const FitPriors& priors,
-                                std::chrono::steady_clock::time_point started,
-                                FitSummary summary, Parameters& best) {
+// The estimate of the view `obs` under `camera` (params.camera or one of
+// params.rig_cameras) and its account: per-frame residuals, the frames that
+// did not converge, the summary completed.
+ViewEstimate ReportView(const Observations& obs, const KinematicModel& model,
+                        const Character& character, const FitOptions& options,
+                        const CameraParameters& camera,
+                        std::chrono::steady_clock::time_point started,
+                        FitSummary summary, Parameters& params) {
+  ViewEstimate estimate;
+  estimate.skeleton_name = model.skeleton_name;
+  for (size_t c = 0; c < camera.centres_m.size(); ++c)
+    estimate.cameras.push_back(camera.ToPinhole(static_cast<int>(c), obs));
+  double weighted_sum = 0.0, weight_total = 0.0;
+  const double unconverged_px =
+      options.unconverged_residual_scale * obs.median_scale_px;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    estimate.poses.push_back(FittedPose(character, params.root_m[t].data(),
+                                        params.quaternion_wxyz[t].data(),
+                                        params.hinges_rad[t].data()));
+    const double residual = FrameResidualPx(obs, model, camera, params, t,
+                                            &weighted_sum, &weight_total);
+    estimate.residual_px.push_back(residual);
+    if (!obs.usable[t] || residual > unconverged_px)
+      summary.unconverged_frames.push_back(t);
+  }
+  summary.mean_reprojection_px =
+      weight_total > 0 ? weighted_sum / weight_total : 0.0;
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
+          .count();
+  estimate.summary = summary;
+  return estimate;
+}
+
+// Stages 2 to 4 from `best` over its camera and, for a rig, its other
+// cameras (`rig_obs` their views); returns the first camera's estimate
+// (ReportView), `summary` given the iterations and final cost.
+ViewEstimate SolvePoseAndReport(
+    const Observations& obs, const KinematicModel& model,
+    const KeypointLayout& layout, const Character& character,
+    const FitOptions& options, const FitPriors& priors,
+    std::chrono::steady_clock::time_point started, FitSummary& summary,
+    Parameters& best, const std::vector<Observations>& rig_obs = {}) {
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
   // Stage 2 continues: the full pose.
   StageResult pose =
       SolveStage(Stage::kPose, options.pose_stage_iterations, obs, model,
-                 layout, options, priors, nullptr, best);
+                 layout, options, priors, nullptr, best, rig_obs);
   summary.iterations += pose.iterations;
   say("stage 2 (full pose): cost " + std::to_string(pose.initial_cost) +
       " -> " + std::to_string(pose.final_cost) + "; " + DescribeCamera(best) +
@@ -1250,7 +1360,7 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
         CurrentContacts(obs, model, layout, options, best);
     final_stage =
         SolveStage(Stage::kPoseWithContacts, options.pose_stage_iterations, obs,
-                   model, layout, options, priors, &contacts, best);
+                   model, layout, options, priors, &contacts, best, rig_obs);
     summary.iterations += final_stage.iterations;
     say("stage 3 (contacts, round " + std::to_string(round + 1) + "): cost " +
         std::to_string(final_stage.initial_cost) + " -> " +
@@ -1263,43 +1373,17 @@ ViewEstimate SolvePoseAndReport(const Observations& obs,
   if (options.refine_iterations > 0) {
     const ContactWeights contacts =
         CurrentContacts(obs, model, layout, options, best);
-    final_stage = SolveStage(Stage::kRefine, options.refine_iterations, obs,
-                             model, layout, options, priors, &contacts, best);
+    final_stage =
+        SolveStage(Stage::kRefine, options.refine_iterations, obs, model,
+                   layout, options, priors, &contacts, best, rig_obs);
     summary.iterations += final_stage.iterations;
     say("stage 4 (refine, camera held): cost " +
         std::to_string(final_stage.initial_cost) + " -> " +
         std::to_string(final_stage.final_cost) + Seconds(final_stage.seconds));
   }
   summary.final_cost = final_stage.final_cost;
-
-  // The estimate and its account.
-  ViewEstimate estimate;
-  estimate.skeleton_name = model.skeleton_name;
-  for (size_t c = 0; c < best.centres_m.size(); ++c) {
-    estimate.cameras.push_back(
-        ToPinholeCamera(best.focal_px, best.pitch_roll_rad,
-                        best.centres_m[c].data(), obs.width_px, obs.height_px));
-  }
-  double weighted_sum = 0.0, weight_total = 0.0;
-  const double unconverged_px =
-      options.unconverged_residual_scale * obs.median_scale_px;
-  for (int t = 0; t < obs.num_frames; ++t) {
-    estimate.poses.push_back(FittedPose(character, best.root_m[t].data(),
-                                        best.quaternion_wxyz[t].data(),
-                                        best.hinges_rad[t].data()));
-    const double residual =
-        FrameResidualPx(obs, model, best, t, &weighted_sum, &weight_total);
-    estimate.residual_px.push_back(residual);
-    if (!obs.usable[t] || residual > unconverged_px)
-      summary.unconverged_frames.push_back(t);
-  }
-  summary.mean_reprojection_px =
-      weight_total > 0 ? weighted_sum / weight_total : 0.0;
-  summary.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started)
-          .count();
-  estimate.summary = summary;
-  return estimate;
+  return ReportView(obs, model, character, options, best.camera, started,
+                    summary, best);
 }
 
 // `cameras` (1, or one per frame) and `poses` in the fit's frame (the
@@ -1324,15 +1408,16 @@ Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
   }
   const PinholeCamera& camera = cameras.front();
   Parameters params;
-  params.focal_px = options.fixed_focal_px > 0 ? options.fixed_focal_px
-                                               : camera.intrinsics().fx_px;
+  params.camera.focal_px = options.fixed_focal_px > 0
+                               ? options.fixed_focal_px
+                               : camera.intrinsics().fx_px;
   const Eigen::Vector2d pitch_roll = CameraPitchRollRad(camera);
-  params.pitch_roll_rad[0] = pitch_roll[0];
-  params.pitch_roll_rad[1] = pitch_roll[1];
+  params.camera.pitch_roll_rad[0] = pitch_roll[0];
+  params.camera.pitch_roll_rad[1] = pitch_roll[1];
   // The world turned about z so that the camera looks along +x, and moved
   // so that its centre is above the origin.
   const Eigen::Matrix3d turn =
-      FitCameraRotation(params.pitch_roll_rad).transpose() *
+      FitCameraRotation(params.camera.pitch_roll_rad).transpose() *
       camera.rotation_world_to_camera();
   const Eigen::Vector3d centre = camera.CenterWorld();
   const Eigen::Vector3d shift(centre.x(), centre.y(), 0.0);
@@ -1342,7 +1427,7 @@ Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
        (options.camera_motion == CameraMotion::kMoving ? obs.num_frames : 1);
        ++c) {
     const PinholeCamera& at = cameras[std::min<size_t>(c, cameras.size() - 1)];
-    params.centres_m.push_back(turn * (at.CenterWorld() - shift));
+    params.camera.centres_m.push_back(turn * (at.CenterWorld() - shift));
   }
   // Along the clip: frame by frame the ball joints' Euler solutions can
   // switch (docs/fit.md, "Euler switches in the truth").
@@ -1364,6 +1449,72 @@ Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
     params.hinges_rad.push_back(std::move(hinges));
   }
   return params;
+}
+
+// Yaws tried when placing a rig's camera against a fitted body (every
+// 45 deg: a camera-only solve crosses a quarter of that).
+constexpr int kRigCameraYawStarts = 8;
+
+// A rig's camera placed against `body` (held): from each of
+// kRigCameraYawStarts headings around the body's mean root, at the
+// horizontal distance and height its own fit found (`alone`, that fit's
+// camera; its focal held, its pitch and roll the start), the camera alone
+// solved to its view `obs`; the lowest reprojection cost wins. Its own
+// fit's body is not used: a depth or facing its fit got wrong would misplace
+// it.
+CameraParameters PlaceRigCamera(const Observations& obs,
+                                const KinematicModel& model,
+                                const FitOptions& options,
+                                const FitPriors& priors,
+                                const CameraParameters& alone,
+                                double distance_m, Parameters& body,
+                                int* iterations) {
+  Eigen::Vector3d mean_root = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& root : body.root_m) mean_root += root;
+  mean_root /= static_cast<double>(body.root_m.size());
+  const std::vector<double> all_keypoints(obs.num_keypoints, 1.0);
+  CameraParameters best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int start = 0; start < kRigCameraYawStarts; ++start) {
+    CameraParameters camera = alone;
+    camera.yaw_rad = 2.0 * M_PI * start / kRigCameraYawStarts;
+    camera.centres_m.assign(
+        1,
+        Eigen::Vector3d(mean_root.x() - distance_m * std::cos(camera.yaw_rad),
+                        mean_root.y() - distance_m * std::sin(camera.yaw_rad),
+                        alone.centres_m[0].z()));
+    ceres::Problem problem;
+    for (int t = 0; t < obs.num_frames; ++t) {
+      problem.AddResidualBlock(
+          FrameCost::Create(MakeFrameCost(obs, model, options, priors,
+                                          all_keypoints, t, false, true)),
+          nullptr, FrameBlocks(camera, body, t, true));
+      for (double* block :
+           {body.root_m[t].data(), body.quaternion_wxyz[t].data(),
+            body.hinges_rad[t].data()}) {
+        problem.SetParameterBlockConstant(block);
+      }
+    }
+    problem.SetParameterBlockConstant(&camera.focal_px);
+    problem.SetParameterLowerBound(camera.pitch_roll_rad, 0, -1.3);
+    problem.SetParameterUpperBound(camera.pitch_roll_rad, 0, 1.3);
+    problem.SetParameterLowerBound(camera.pitch_roll_rad, 1, -0.7);
+    problem.SetParameterUpperBound(camera.pitch_roll_rad, 1, 0.7);
+    problem.SetParameterLowerBound(camera.centres_m[0].data(), 2, 0.1);
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;  // 7 unknowns
+    solver.max_num_iterations = options.root_stage_iterations;
+    solver.function_tolerance = options.function_tolerance;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    *iterations += static_cast<int>(summary.iterations.size());
+    if (summary.final_cost < best_cost) {
+      best_cost = summary.final_cost;
+      best = camera;
+    }
+  }
+  return best;
 }
 
 // A given state (cameras and poses) read against its clip, in the fit's
@@ -1677,6 +1828,134 @@ std::string FitTermCosts::BriefReport() const {
   return report + text;
 }
 
+ReferenceBundle FitRig(
+    const ReferenceBundle& bundle, const Character& character,
+    const FitOptions& options, const std::string& source,
+    const std::function<void(int view, const ViewEstimate&)>& progress) {
+  // Outline: fit each view alone (FitView); then, with each view's own fit
+  // as the body, place every other camera against that body
+  // (PlaceRigCamera) and screen a short full-pose solve over all the
+  // cameras; the lowest screening cost continues through stages 2 to 4 over
+  // all the cameras at once (that start's own camera defines the world);
+  // report each view in that one world.
+  options.Validate();
+  const auto started = std::chrono::steady_clock::now();
+  const int num_views = static_cast<int>(bundle.views.size());
+  if (options.camera_motion != CameraMotion::kStatic) {
+    throw ConfigError(
+        "fit --rig: a rig's cameras are static (camera_motion static)");
+  }
+  if (num_views < 2) {
+    throw InputError(source,
+                     "fit --rig needs 2 or more views; the bundle has " +
+                         std::to_string(num_views));
+  }
+  auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
+  const KinematicModel model = KinematicModel::FromCharacter(character);
+  const KeypointLayout& layout = *bundle.views[0].clip.layout;
+  std::vector<std::string> sources;
+  std::vector<Observations> obs;
+  for (const ReferenceView& view : bundle.views) {
+    sources.push_back(source + " (view " + view.name + ")");
+    obs.push_back(ReadCharacterObservations(view.clip, character, options,
+                                            sources.back()));
+    if (obs.back().num_frames != obs[0].num_frames) {
+      throw InputError(sources.back(),
+                       std::to_string(obs.back().num_frames) +
+                           " frames; a rig's views are one take (view " +
+                           bundle.views[0].name + " has " +
+                           std::to_string(obs[0].num_frames) + ")");
+    }
+  }
+
+  // Each view alone, in its own world (the fit's frame).
+  std::vector<Parameters> own;
+  std::vector<double> distance_m;  // camera to the body's root, horizontal
+  int iterations = 0;
+  for (int v = 0; v < num_views; ++v) {
+    say("view " + bundle.views[v].name + " alone:");
+    const ViewEstimate alone =
+        FitView(bundle.views[v].clip, character, options, sources[v]);
+    iterations += alone.summary.iterations;
+    own.push_back(GivenParameters(obs[v], model, character, options,
+                                  alone.cameras, alone.poses, sources[v]));
+    double sum = 0.0;
+    for (const Eigen::Vector3d& root : own.back().root_m)
+      sum += (root - own.back().camera.centres_m[0]).head<2>().norm();
+    distance_m.push_back(sum / obs[v].num_frames);
+  }
+
+  // Every view's body as the start; the others' cameras placed against it.
+  Parameters best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  int best_view = 0;
+  for (int m = 0; m < num_views; ++m) {
+    Parameters params = own[m];
+    const FitPriors priors =
+        MakeFitPriors(character, model, layout, options, obs[m], sources[m]);
+    std::vector<Observations> rig_obs;
+    for (int k = 0; k < num_views; ++k) {
+      if (k == m) continue;
+      params.rig_cameras.push_back(
+          PlaceRigCamera(obs[k], model, options, priors, own[k].camera,
+                         distance_m[k], params, &iterations));
+      rig_obs.push_back(obs[k]);
+    }
+    const StageResult screen =
+        SolveStage(Stage::kPose, options.screening_iterations, obs[m], model,
+                   layout, options, priors, nullptr, params, rig_obs);
+    iterations += screen.iterations;
+    char line[160];
+    std::snprintf(line, sizeof(line),
+                  "rig start %d/%d (the body of view %s): cameras placed, "
+                  "full pose %.4g -> %.4g (%.2f s)",
+                  m + 1, num_views, bundle.views[m].name.c_str(),
+                  screen.initial_cost, screen.final_cost, screen.seconds);
+    say(line);
+    if (screen.final_cost < best_cost) {
+      best_cost = screen.final_cost;
+      best_view = m;
+      best = std::move(params);
+    }
+  }
+
+  // Stages 2 to 4 over every camera, from the best start.
+  const int m = best_view;
+  const FitPriors priors =
+      MakeFitPriors(character, model, layout, options, obs[m], sources[m]);
+  std::vector<Observations> rig_obs;
+  for (int k = 0; k < num_views; ++k)
+    if (k != m) rig_obs.push_back(obs[k]);
+  FitSummary summary;
+  summary.camera_model = CameraMotionName(options.camera_motion);
+  summary.focal_fixed = options.fixed_focal_px > 0;
+  summary.num_frames = obs[m].num_frames;
+  summary.pose_prior = priors.pose_prior_name;
+  summary.initialization = "rig of " + std::to_string(num_views) +
+                           " cameras, the body of view " +
+                           bundle.views[m].name + "'s own fit";
+  summary.iterations = iterations;
+  summary.initial_cost = best_cost;
+  std::vector<ViewEstimate> estimates(num_views);
+  estimates[m] = SolvePoseAndReport(obs[m], model, layout, character, options,
+                                    priors, started, summary, best, rig_obs);
+  for (int k = 0, i = 0; k < num_views; ++k) {
+    if (k == m) continue;
+    estimates[k] = ReportView(obs[k], model, character, options,
+                              best.rig_cameras[i++], started, summary, best);
+  }
+  for (int v = 0; v < num_views; ++v) {
+    PlaceObjects(bundle.views[v].clip, options, sources[v], &estimates[v]);
+    if (progress) progress(v, estimates[v]);
+  }
+  ReferenceBundle out = bundle;
+  out.estimate = std::move(estimates);
+  out.estimate_one_world = true;
+  return out;
+}
+
 ReferenceBundle FitBundle(
     const ReferenceBundle& bundle, const Character& character,
     const FitOptions& options, const std::string& source,
@@ -1690,6 +1969,7 @@ ReferenceBundle FitBundle(
     if (progress) progress(static_cast<int>(v), estimates.back());
   }
   out.estimate = std::move(estimates);
+  out.estimate_one_world = false;
   return out;
 }
 

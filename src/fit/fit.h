@@ -402,6 +402,19 @@ ReferenceBundle FitBundle(
     const FitOptions& options, const std::string& source,
     const std::function<void(int view, const ViewEstimate&)>& progress = {});
 
+// Fits the views of `bundle` as one synchronized take of static cameras (a
+// calibrated rig: `mimic2d fit --rig`): one body seen by every camera, each
+// camera with its own pitch, roll, yaw and position (the focal as
+// options.fixed_focal_px says), from the 2D alone. Starts from each view's
+// own fit (FitView); every view's estimate then holds its camera and the
+// same poses, in one world. Throws ConfigError for a moving camera and
+// InputError for fewer than 2 views or views of different lengths.
+// `progress` is called per view at the end.
+ReferenceBundle FitRig(
+    const ReferenceBundle& bundle, const Character& character,
+    const FitOptions& options, const std::string& source,
+    const std::function<void(int view, const ViewEstimate&)>& progress = {});
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_FIT_FIT_H_

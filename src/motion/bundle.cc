@@ -441,8 +441,12 @@ ReferenceBundle ReadBundle(const std::string& path) {
   if (root.Has("ground_truth")) {
     bundle.ground_truth = GroundTruthFromJson(root.Field("ground_truth"));
   }
-  if (version >= 2 && root.Has("estimate"))
-    bundle.estimate = EstimateFromJson(root.Field("estimate"), bundle.views);
+  if (version >= 2 && root.Has("estimate")) {
+    const JsonCursor estimate = root.Field("estimate");
+    bundle.estimate = EstimateFromJson(estimate, bundle.views);
+    bundle.estimate_one_world =
+        estimate.Has("one_world") && estimate.Field("one_world").Boolean();
+  }
   ValidateBundle(bundle, path);
   return bundle;
 }
@@ -466,14 +470,17 @@ void WriteBundle(const std::string& path, const ReferenceBundle& bundle) {
                          {"views", views}};
   if (bundle.ground_truth)
     json["ground_truth"] = GroundTruthToJson(*bundle.ground_truth);
-  if (bundle.estimate)
+  if (bundle.estimate) {
     json["estimate"] = EstimateToJson(*bundle.estimate, bundle.views);
+    if (bundle.estimate_one_world) json["estimate"]["one_world"] = true;
+  }
   WriteJsonFileAtomic(path, json);
 }
 
 ReferenceBundle StripBundle(ReferenceBundle bundle) {
   bundle.ground_truth.reset();
   bundle.estimate.reset();
+  bundle.estimate_one_world = false;
   for (ReferenceView& view : bundle.views) view.cameras.clear();
   return bundle;
 }

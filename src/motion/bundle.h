@@ -106,6 +106,10 @@ struct ReferenceBundle {
   std::optional<GroundTruth3D> ground_truth;
   // From `mimic2d fit`: one entry per view, in view order.
   std::optional<std::vector<ViewEstimate>> estimate;
+  // The views' estimates share one world (`mimic2d fit --rig`: the same
+  // poses, the cameras placed together), so the views can be tracked at
+  // once under the estimated cameras; false: each view's world is its own.
+  bool estimate_one_world = false;
 
   int num_frames() const {
     return views.empty() ? 0 : views.front().clip.num_frames();

@@ -759,6 +759,10 @@ TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
   ExpectInputError("fit " + stripped + " --quiet --truth " + stripped + " -o " +
                        dir + "/never.json",
                    stripped, "holds no 3D truth");
+  // A rig is two or more views of one take.
+  ExpectInputError("fit " + dir + "/one_view.json --rig --quiet -o " + dir +
+                       "/never.json",
+                   dir + "/one_view.json", "needs 2 or more views");
   std::filesystem::remove_all(dir);
 }
 

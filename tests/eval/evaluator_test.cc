@@ -438,7 +438,8 @@ TEST(EvaluatePolicy, ObjectStartsMoveWithinTheirSquare) {
 // Zero-shot multi-view: K = 3 rolls each of the walk's 4 views out with the
 // two next ones, named together; with a policy that ignores what it sees,
 // the 3D outcome equals the one-view evaluation's from the same starts. A
-// view set needs one world: per-view estimated cameras are refused.
+// view set needs one world: per-view estimated cameras are refused, a rig's
+// estimate is not.
 TEST(EvaluatePolicy, KViewsAreRolledOutTogetherInTheTrueCamerasWorld) {
   M2D_REQUIRE_SHARED(path, kWalk);
   testing::WalkTask task = testing::MakeWalkTask(path, 2.0);
@@ -491,6 +492,18 @@ TEST(EvaluatePolicy, KViewsAreRolledOutTogetherInTheTrueCamerasWorld) {
   EXPECT_THROW(EvaluatePolicy(pair, estimated.character, estimated.reference,
                               estimated.initial_states, env_options, options),
                ConfigError);
+  // A rig's estimate (`fit --rig`) is one world: its views go together.
+  bundle.estimate = testing::EstimateFromTruth(
+      bundle, {{1.2, {2.0, 1.0, 0.0}}, {1.2, {2.0, 1.0, 0.0}}});
+  bundle.estimate_one_world = true;
+  TrackingTask rig = BuildTrackingTask(character, {bundle}, task_options);
+  const std::vector<EvalRow> rig_rows =
+      EvaluatePolicy(pair, rig.character, rig.reference, rig.initial_states,
+                     env_options, options);
+  ASSERT_EQ(rig_rows.size(), 2u);
+  EXPECT_EQ(rig_rows[0].view,
+            bundle.views[0].name + "+" + bundle.views[1].name);
+  EXPECT_TRUE(std::isfinite(rig_rows[0].e2d_px));
 }
 
 }  // namespace

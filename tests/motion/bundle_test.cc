@@ -292,6 +292,12 @@ TEST(Bundle, Version2RoundTripsTheEstimate) {
     EXPECT_EQ(b.summary.unconverged_frames, a.summary.unconverged_frames);
     EXPECT_EQ(b.summary.seconds, a.summary.seconds);
   }
+  // Views fitted alone, each in its own world, unless the file says one.
+  EXPECT_FALSE(read.estimate_one_world);
+  bundle.estimate_one_world = true;
+  WriteBundle(file, bundle);
+  EXPECT_TRUE(ReadBundle(file).estimate_one_world);
+  EXPECT_FALSE(StripBundle(bundle).estimate_one_world);
   // A file whose estimate names views out of order is rejected.
   nlohmann::json json = ReadJsonFile(file);
   std::swap(json["estimate"]["views"][0], json["estimate"]["views"][1]);
