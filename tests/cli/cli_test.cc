@@ -760,9 +760,9 @@ TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
                        dir + "/never.json",
                    stripped, "holds no 3D truth");
   // A rig is two or more views of one take.
-  ExpectInputError("fit " + dir + "/one_view.json --rig --quiet -o " + dir +
-                       "/never.json",
-                   dir + "/one_view.json", "needs 2 or more views");
+  ExpectInputError(
+      "fit " + dir + "/one_view.json --rig --quiet -o " + dir + "/never.json",
+      dir + "/one_view.json", "needs 2 or more views");
   std::filesystem::remove_all(dir);
 }
 
