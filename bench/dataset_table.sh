@@ -14,6 +14,9 @@
 # and SFV_CHECKPOINT name others). Every rollout starts at a
 # clip's first frame and runs to its end (clips are 0.8-4.4 s): one rollout
 # per view. Prints a Markdown table; every row's eval JSON goes to OUT_DIR.
+# On a rig's fits (scripts/make_dataset.sh --rig: each clip's views in one
+# world) the 2- and 3-view rows are also made from 2D, under the rig fit's
+# starts and cameras.
 # SUCCESS_MEASURE=mean_keypoint judges Succ by a frame's mean keypoint
 # error instead of its worst (eval --success-measure; docs/tracking.md).
 set -euo pipefail
@@ -34,6 +37,8 @@ ours=${OURS_CHECKPOINT:-runs/dataset2d/checkpoint.pt}
 gt=${GT_CHECKPOINT:-runs/dataset3d_gt/checkpoint.pt}
 sfv=${SFV_CHECKPOINT:-runs/dataset_sfv/checkpoint.pt}
 measure=${SUCCESS_MEASURE:-worst_keypoint}
+# 1 when the fits are a rig's (the estimate's one_world), else 0.
+rig=$(/usr/bin/python3 -c "import json, sys; print(int(json.load(open(sys.argv[1])).get('estimate', {}).get('one_world', False)))" "$data/walk.json" 2>/dev/null || echo 0)
 
 # bundles SPLIT SUFFIX: --bundle flags for the split's clips.
 bundles() {
@@ -75,6 +80,13 @@ for split in train unseen; do
       row "ours, $views view(s), truth starts, true cameras" "$ours" "$split" "$noise" _truth \
         --starts truth --cameras truth --views "$views"
     done
+    if [ "$rig" = 1 ]; then
+      for views in 2 3; do
+        # shellcheck disable=SC2046
+        row "ours, $views views, from 2D (rig fit's starts and cameras)" "$ours" "$split" "$noise" "" \
+          --views "$views" $(truths "$split" "$([ "$noise" = noisy ] && echo _noisy)")
+      done
+    fi
     # shellcheck disable=SC2046
     row "Sfv* w/ our fit (fit's starts and cameras)" "$sfv" "$split" "$noise" "" \
       $(truths "$split" "$([ "$noise" = noisy ] && echo _noisy)")

@@ -6,7 +6,10 @@
 # character: what a user with four calibrated videos per clip and an animal
 # keypoint detector has (the intrinsics known, `--focal`).
 #
-#   scripts/make_dog_dataset.sh [OUT_DIR]   (default runs/dog)
+#   scripts/make_dog_dataset.sh [--rig] [OUT_DIR]   (default runs/dog)
+#
+# --rig: each clip's four views fitted as one synchronized rig (`fit --rig`,
+# docs/fit.md, "A rig") instead of view by view.
 #
 # Writes OUT_DIR/<clip>_truth.json (for measurement only: eval reads its
 # ground truth for E3D), <clip>_2d.json (stripped) and <clip>.json (the
@@ -17,6 +20,8 @@
 # from $MIMIC2D_SHARED_DATA (default ../shared/data)/deepmimic/motions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+rig=()
+if [ "${1:-}" = --rig ]; then rig=(--rig); shift; fi
 out=${1:-runs/dog}
 shared=${MIMIC2D_SHARED_DATA:-../shared/data}
 motions="$shared/deepmimic/motions"
@@ -39,7 +44,7 @@ make_one() {  # clip
       > /dev/null
   fi
   if $bin fit "$out/${clip}_2d.json" --character "$character" --camera static \
-    --focal 1400 --quiet --truth "$out/${clip}_truth.json" \
+    --focal 1400 --quiet "${rig[@]}" --truth "$out/${clip}_truth.json" \
     -o "$out/$clip.json" > "$out/${clip}_fit.log" 2>&1; then
     echo "fitted $clip: $(grep -m 1 '^mean over the views' "$out/${clip}_fit.log")"
   else
