@@ -1509,7 +1509,8 @@ CameraParameters PlaceRigCamera(const Observations& obs,
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
     *iterations += static_cast<int>(summary.iterations.size());
-    if (summary.final_cost < best_cost) {
+    // The first start stands in when no cost compares (a NaN).
+    if (start == 0 || summary.final_cost < best_cost) {
       best_cost = summary.final_cost;
       best = camera;
     }
