@@ -729,8 +729,6 @@ std::vector<std::pair<int, int>> NearSpherePairs(const KinematicModel& model,
   return near;
 }
 
-// Adds `stage`'s terms over `params` to `problem` (docs/fit.md writes
-// them out); `term_blocks` (optional) records which term each block is.
 // Frame t's reprojection term for `camera` (FrameCost), with the floor and
 // uprightness when `with_body_terms` (once per frame, with the first
 // camera); a rig's other camera (`camera.yaw_rad` a block) without.
@@ -770,9 +768,22 @@ std::vector<double*> FrameBlocks(CameraParameters& camera, Parameters& params,
   return blocks;
 }
 
-// One camera's priors and bounds: the focal fixed or free under its prior,
-// pitch and roll bounded (roll under its prior when weighted), every centre
-// above the floor under the height prior and, when it moves, slow and
+// A camera's bounds: pitch within +-1.3 rad and roll within +-0.7 of level,
+// every centre above the floor.
+void BoundCamera(CameraParameters& camera, ceres::Problem& problem) {
+  problem.SetParameterLowerBound(camera.pitch_roll_rad, 0, -1.3);
+  problem.SetParameterUpperBound(camera.pitch_roll_rad, 0, 1.3);
+  problem.SetParameterLowerBound(camera.pitch_roll_rad, 1, -0.7);
+  problem.SetParameterUpperBound(camera.pitch_roll_rad, 1, 0.7);
+  for (Eigen::Vector3d& centre : camera.centres_m) {
+    if (problem.HasParameterBlock(centre.data()))
+      problem.SetParameterLowerBound(centre.data(), 2, 0.1);
+  }
+}
+
+// One camera's priors and bounds (BoundCamera): the focal fixed or free under
+// its prior, pitch and roll bounded (roll under its prior when weighted), every
+// centre above the floor under the height prior and, when it moves, slow and
 // smooth; all held in stage 4 (refine). `defines_world`: the first centre's
 // x and y are held (the world's origin is below the first camera, and its
 // heading is that camera's yaw).
@@ -801,10 +812,7 @@ void AddCameraTerms(Stage stage, const FitOptions& options,
           CameraRollPriorCost::Create(0.0, options.camera_roll_prior_weight),
           {camera.pitch_roll_rad});
     }
-    problem.SetParameterLowerBound(camera.pitch_roll_rad, 0, -1.3);
-    problem.SetParameterUpperBound(camera.pitch_roll_rad, 0, 1.3);
-    problem.SetParameterLowerBound(camera.pitch_roll_rad, 1, -0.7);
-    problem.SetParameterUpperBound(camera.pitch_roll_rad, 1, 0.7);
+    BoundCamera(camera, problem);
   }
   const int num_centres = static_cast<int>(camera.centres_m.size());
   for (int c = 0; c < num_centres; ++c) {
@@ -812,7 +820,6 @@ void AddCameraTerms(Stage stage, const FitOptions& options,
     if (!problem.HasParameterBlock(centre)) continue;
     if (c == 0 && defines_world)
       problem.SetManifold(centre, new ceres::SubsetManifold(3, {0, 1}));
-    problem.SetParameterLowerBound(centre, 2, 0.1);
     // A person filming stands (or a tripod stands) about this high; spread
     // over a moving camera's frames so its strength does not grow with
     // the clip.
@@ -862,9 +869,9 @@ void BuildProblem(Stage stage, const Observations& obs,
                   const std::vector<Observations>& rig_obs = {}) {
   const int num_frames = obs.num_frames;
   const int num_hinges = model.num_hinges();
-  const std::vector<double> all_keypoints(obs.num_keypoints, 1.0);
-  const std::vector<double>& keypoint_mask =
-      stage == Stage::kRoot ? TorsoMask(layout) : all_keypoints;
+  const std::vector<double> keypoint_mask =
+      stage == Stage::kRoot ? TorsoMask(layout)
+                            : std::vector<double>(obs.num_keypoints, 1.0);
   if (rig_obs.size() != params.rig_cameras.size())
     throw std::logic_error("BuildProblem: a rig camera without its view");
 
@@ -1496,11 +1503,7 @@ CameraParameters PlaceRigCamera(const Observations& obs,
       }
     }
     problem.SetParameterBlockConstant(&camera.focal_px);
-    problem.SetParameterLowerBound(camera.pitch_roll_rad, 0, -1.3);
-    problem.SetParameterUpperBound(camera.pitch_roll_rad, 0, 1.3);
-    problem.SetParameterLowerBound(camera.pitch_roll_rad, 1, -0.7);
-    problem.SetParameterUpperBound(camera.pitch_roll_rad, 1, 0.7);
-    problem.SetParameterLowerBound(camera.centres_m[0].data(), 2, 0.1);
+    BoundCamera(camera, problem);
     ceres::Solver::Options solver;
     solver.linear_solver_type = ceres::DENSE_QR;  // 7 unknowns
     solver.max_num_iterations = options.root_stage_iterations;
@@ -1889,12 +1892,19 @@ ReferenceBundle FitRig(
   }
 
   // Every view's body as the start; the others' cameras placed against it.
-  Parameters best;
-  double best_cost = std::numeric_limits<double>::infinity();
-  int best_view = 0;
+  // The best start keeps its state, its view's priors and the other views.
+  struct RigStart {
+    int view = 0;
+    Parameters params;
+    FitPriors priors;
+    std::vector<Observations> rig_obs;
+    StageResult screen;
+  };
+  RigStart best;
+  best.screen.final_cost = std::numeric_limits<double>::infinity();
   for (int m = 0; m < num_views; ++m) {
     Parameters params = own[m];
-    const FitPriors priors =
+    FitPriors priors =
         MakeFitPriors(character, model, layout, options, obs[m], sources[m]);
     std::vector<Observations> rig_obs;
     for (int k = 0; k < num_views; ++k) {
@@ -1915,37 +1925,33 @@ ReferenceBundle FitRig(
                   m + 1, num_views, bundle.views[m].name.c_str(),
                   screen.initial_cost, screen.final_cost, screen.seconds);
     say(line);
-    if (screen.final_cost < best_cost) {
-      best_cost = screen.final_cost;
-      best_view = m;
-      best = std::move(params);
+    if (screen.final_cost < best.screen.final_cost) {
+      best = {m, std::move(params), std::move(priors), std::move(rig_obs),
+              screen};
     }
   }
 
   // Stages 2 to 4 over every camera, from the best start.
-  const int m = best_view;
-  const FitPriors priors =
-      MakeFitPriors(character, model, layout, options, obs[m], sources[m]);
-  std::vector<Observations> rig_obs;
-  for (int k = 0; k < num_views; ++k)
-    if (k != m) rig_obs.push_back(obs[k]);
+  const int m = best.view;
   FitSummary summary;
   summary.camera_model = CameraMotionName(options.camera_motion);
   summary.focal_fixed = options.fixed_focal_px > 0;
   summary.num_frames = obs[m].num_frames;
-  summary.pose_prior = priors.pose_prior_name;
+  summary.pose_prior = best.priors.pose_prior_name;
   summary.initialization = "rig of " + std::to_string(num_views) +
                            " cameras, the body of view " +
                            bundle.views[m].name + "'s own fit";
   summary.iterations = iterations;
-  summary.initial_cost = best_cost;
+  summary.initial_cost = best.screen.initial_cost;
   std::vector<ViewEstimate> estimates(num_views);
-  estimates[m] = SolvePoseAndReport(obs[m], model, layout, character, options,
-                                    priors, started, summary, best, rig_obs);
+  estimates[m] =
+      SolvePoseAndReport(obs[m], model, layout, character, options, best.priors,
+                         started, summary, best.params, best.rig_obs);
   for (int k = 0, i = 0; k < num_views; ++k) {
     if (k == m) continue;
-    estimates[k] = ReportView(obs[k], model, character, options,
-                              best.rig_cameras[i++], started, summary, best);
+    estimates[k] =
+        ReportView(obs[k], model, character, options,
+                   best.params.rig_cameras[i++], started, summary, best.params);
   }
   for (int v = 0; v < num_views; ++v) {
     PlaceObjects(bundle.views[v].clip, options, sources[v], &estimates[v]);
