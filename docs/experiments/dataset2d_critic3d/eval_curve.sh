@@ -12,20 +12,24 @@
 # MIMIC2D names the binary (default build/mimic2d), DATA the bundles' folder
 # (default runs/dataset, scripts/make_dataset.sh). TRUTH=1 evaluates a 3D-GT
 # run instead (configs/dataset3d_gt.yaml): the truth bundles, with the truth's
-# starts and the true cameras, as the table's 3D-GT row.
+# starts and the true cameras, as the table's 3D-GT row. NOISY=1 evaluates on
+# the noisy 2D instead (the <clip>_noisy bundles, fitted on it; eval JSONs
+# named eval_noisy_<samples>.json).
 set -euo pipefail
 mimic2d=${MIMIC2D:-build/mimic2d}
 data=${DATA:-runs/dataset}
 target=$1 variant=$2
 clips="walk jog run kick punch jump dance_a stealthy_walk zombie_walk spin"
+noisy="" tag=""
+if [ "${NOISY:-0}" = 1 ]; then noisy=_noisy tag=noisy_; fi
 args=()
 if [ "${TRUTH:-0}" = 1 ]; then
-  for clip in $clips; do args+=(--bundle "$data/${clip}_truth.json"); done
+  for clip in $clips; do args+=(--bundle "$data/${clip}${noisy}_truth.json"); done
   args+=(--starts truth --cameras truth)
 else
-  for clip in $clips; do args+=(--bundle "$data/$clip.json"); done
+  for clip in $clips; do args+=(--bundle "$data/$clip$noisy.json"); done
   args+=(--truth)
-  for clip in $clips; do args+=("$data/${clip}_truth.json"); done
+  for clip in $clips; do args+=("$data/${clip}${noisy}_truth.json"); done
 fi
 
 # evaluate CHECKPOINT JSON SAMPLES: one row (the eval JSON is cached).
@@ -37,12 +41,12 @@ evaluate() {
 
 if [ -f "$target" ]; then
   samples=$("$mimic2d" checkpoint info "$target" | awk '$1 == "trained:" {print $2}')
-  evaluate "$target" "${target%.pt}.eval.json" "$samples"
+  evaluate "$target" "${target%.pt}.${tag}eval.json" "$samples"
   exit 0
 fi
 kept=$target/checkpoints
 # In order of samples (sorted on the file name alone: the folder may hold _).
 for name in $(cd "$kept" && printf '%s\n' ckpt_*.pt | sort -t_ -k2 -n); do
   n=$(basename "$name" .pt | cut -d_ -f2)
-  evaluate "$kept/$name" "$target/eval_$n.json" "$n"
+  evaluate "$kept/$name" "$target/eval_$tag$n.json" "$n"
 done
