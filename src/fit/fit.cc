@@ -1901,7 +1901,6 @@ ReferenceBundle FitRig(
     StageResult screen;
   };
   RigStart best;
-  best.screen.final_cost = std::numeric_limits<double>::infinity();
   for (int m = 0; m < num_views; ++m) {
     Parameters params = own[m];
     FitPriors priors =
@@ -1925,7 +1924,8 @@ ReferenceBundle FitRig(
                   m + 1, num_views, bundle.views[m].name.c_str(),
                   screen.initial_cost, screen.final_cost, screen.seconds);
     say(line);
-    if (screen.final_cost < best.screen.final_cost) {
+    // The first start stands in when no cost compares (a NaN).
+    if (m == 0 || screen.final_cost < best.screen.final_cost) {
       best = {m, std::move(params), std::move(priors), std::move(rig_obs),
               screen};
     }
