@@ -25,7 +25,9 @@ struct BenchFitArgs {
   std::vector<std::string> clips{"walk", "run", "jump", "kick", "dance_a"};
   int views = 2;
   int threads = 1;
-  std::string output;  // JSON; empty: none
+  double min_duration_s = 0.0;  // loop cyclic clips to this long (s)
+  double max_duration_s = 4.0;  // cut longer clips (s)
+  std::string output;           // JSON; empty: none
   std::string motion_dir;
   std::string config;                 // FitOptions YAML; "": the defaults
   std::vector<std::string> settings;  // names; empty: all
@@ -44,6 +46,8 @@ int RunBenchFit(const BenchFitArgs& args) {
   options.clips = args.clips;
   options.num_views = args.views;
   options.num_threads = args.threads;
+  options.min_duration_s = args.min_duration_s;
+  options.max_duration_s = args.max_duration_s;
   if (!args.config.empty()) options.fit = ReadFitOptions(args.config);
   if (!args.settings.empty()) {
     std::vector<FitCameraSetting> chosen;
@@ -73,12 +77,14 @@ int RunBenchFit(const BenchFitArgs& args) {
 
   std::printf(
       "bench fit: %zu clip(s) x %zu camera setting(s) x %s, %d "
-      "view(s) each, at most %.0f s per clip, %d solver thread(s)\n",
+      "view(s) each, at most %.0f s per clip (looping clips at least "
+      "%.1f s), %d solver thread(s)\n",
       options.clips.size(), options.settings.size(),
       options.clean && options.noisy ? "clean and noisy 2D"
       : options.clean                ? "clean 2D"
                                      : "noisy 2D",
-      options.num_views, options.max_duration_s, options.num_threads);
+      options.num_views, options.max_duration_s, options.min_duration_s,
+      options.num_threads);
   for (const FitCameraSetting& setting : options.settings) {
     std::printf("  setting %s: %s\n", setting.name.c_str(),
                 setting.description.c_str());
@@ -138,6 +144,13 @@ void AddBenchFitSubcommand(CLI::App* bench, CommandRun* run) {
       fit->add_option("--views", args->views, "Rig views per bundle")
           ->capture_default_str();
   fit->add_option("--threads", args->threads, "Ceres threads per fit")
+      ->capture_default_str();
+  fit->add_option("--min-duration", args->min_duration_s,
+                  "Repeat a looping clip to at least this long (s, at most "
+                  "--max-duration); clips that do not loop keep their length")
+      ->capture_default_str();
+  fit->add_option("--max-duration", args->max_duration_s,
+                  "Cut clips longer than this (s)")
       ->capture_default_str();
   fit->add_option("-o,--output", args->output,
                   "Write the table as JSON (atomically)")

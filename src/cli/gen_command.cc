@@ -525,6 +525,7 @@ int RunGenEval(const GenEvalArgs& args) {
         {"fid_floor_sampled", result.fid_floor_sampled},
         {"fid_floor_sampled_segment", result.fid_floor_sampled_segment},
         {"fid_reconstruction", result.fid_reconstruction},
+        {"fid_stream_reconstruction", result.fid_stream_reconstruction},
         {"reconstruction_pose_error", result.reconstruction_pose_error},
         {"reconstruction_root_error", result.reconstruction_root_error},
         {"reconstruction_scale_error", result.reconstruction_scale_error},

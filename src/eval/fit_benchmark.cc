@@ -53,26 +53,6 @@ std::vector<std::string> AvailableClips(const std::string& motion_dir) {
   return {clips.begin(), clips.end()};
 }
 
-ReferenceBundle MakeBenchmarkBundle(const Motion3D& motion,
-                                    const Character& character,
-                                    const FitBenchmarkOptions& options,
-                                    const FitCameraSetting& setting, bool noisy,
-                                    const std::string& name) {
-  BundleFromMotionOptions bundle_options;
-  // The clip's own length, cut at max_duration_s (0 = as is, no looping).
-  bundle_options.duration_s = motion.duration_s() > options.max_duration_s
-                                  ? options.max_duration_s
-                                  : 0.0;
-  bundle_options.follow = setting.follow;
-  bundle_options.rig.num_views = options.num_views;
-  bundle_options.rig.elevation_deg = setting.elevation_deg;
-  bundle_options.rig.distance_m = setting.distance_m;
-  bundle_options.rig.focal_px = setting.focal_px;
-  if (noisy) bundle_options.noise = options.noise;
-  return MakeBundleFromMotion(motion, character.keypoint_map(), bundle_options,
-                              name);
-}
-
 nlohmann::json AccuracyJson(const FitAccuracy& a) {
   return {{"num_frames", a.num_frames},
           {"focal_error_pct", a.focal_error_pct},
@@ -177,6 +157,10 @@ void FitBenchmarkOptions::Validate() const {
   if (num_threads < 1) throw ConfigError("bench fit: --threads must be >= 1");
   if (!(max_duration_s > 0))
     throw ConfigError("bench fit: the clip duration must be positive");
+  if (!(min_duration_s >= 0) || min_duration_s > max_duration_s)
+    throw ConfigError(
+        "bench fit: --min-duration must be within [0, the clip cut at " +
+        std::to_string(max_duration_s) + " s]");
   noise.Validate();
   for (const std::string& clip : clips) {
     if (clip.empty() || clip.find('/') != std::string::npos ||
@@ -189,6 +173,28 @@ void FitBenchmarkOptions::Validate() const {
           "; clips there: " + (known.empty() ? "none" : known) + ")");
     }
   }
+}
+
+ReferenceBundle MakeBenchmarkBundle(const Motion3D& motion,
+                                    const Character& character,
+                                    const FitBenchmarkOptions& options,
+                                    const FitCameraSetting& setting, bool noisy,
+                                    const std::string& name) {
+  BundleFromMotionOptions bundle_options;
+  // The clip's own length, a looping clip repeated to min_duration_s, cut
+  // at max_duration_s (duration 0 = the clip as it is).
+  double length_s = motion.duration_s();
+  if (motion.loops) length_s = std::max(length_s, options.min_duration_s);
+  length_s = std::min(length_s, options.max_duration_s);
+  bundle_options.duration_s = length_s == motion.duration_s() ? 0.0 : length_s;
+  bundle_options.follow = setting.follow;
+  bundle_options.rig.num_views = options.num_views;
+  bundle_options.rig.elevation_deg = setting.elevation_deg;
+  bundle_options.rig.distance_m = setting.distance_m;
+  bundle_options.rig.focal_px = setting.focal_px;
+  if (noisy) bundle_options.noise = options.noise;
+  return MakeBundleFromMotion(motion, character.keypoint_map(), bundle_options,
+                              name);
 }
 
 FitBenchmarkResult RunFitBenchmark(const Character& character,
@@ -433,6 +439,7 @@ nlohmann::json FitBenchmarkToJson(const FitBenchmarkResult& result,
           {"num_views", options.num_views},
           {"num_threads", options.num_threads},
           {"max_duration_s", options.max_duration_s},
+          {"min_duration_s", options.min_duration_s},
           {"clean", options.clean},
           {"noisy", options.noisy},
           {"noise",

@@ -44,7 +44,13 @@ struct FitBenchmarkOptions {
   DetectorNoiseOptions noise{4.0, 0.05, 0.0, 11};
   int num_views = 2;            // rig views per bundle, each fitted on its own
   double max_duration_s = 4.0;  // clips longer than this are cut
-  int num_threads = 1;          // Ceres threads per fit
+  // > 0: a looping clip (DeepMimic "wrap") shorter than this is repeated to
+  // at least this long, cut at max_duration_s; a clip that does not loop
+  // keeps its own length. A video is seconds long, a DeepMimic cycle 0.8-
+  // 1.8 s: under a following camera the clip's travel is what shows the
+  // ground (docs/fit.md, "Clip length under a following camera").
+  double min_duration_s = 0.0;
+  int num_threads = 1;  // Ceres threads per fit
   FitOptions fit;  // every fit's settings (camera model and threads: above)
   // Also refine each view from its true camera and poses (fit/fit.h's
   // RefineView, hinges clamped to their ranges): where the objective's own
@@ -86,6 +92,16 @@ struct FitBenchmarkResult {
   FitAccuracy from_truth;
   int num_search_misses = 0;
 };
+
+// One clip's synthetic bundle under one setting: the clip at its own
+// length (a looping one repeated to options.min_duration_s), cut at
+// options.max_duration_s, seen by options.num_views views, with
+// options.noise when `noisy`.
+ReferenceBundle MakeBenchmarkBundle(const Motion3D& motion,
+                                    const Character& character,
+                                    const FitBenchmarkOptions& options,
+                                    const FitCameraSetting& setting, bool noisy,
+                                    const std::string& name);
 
 // Runs the table. The fit reads only each view's 2D clip; the truth is read
 // by the measurement alone. A fit that throws (input it cannot use) is

@@ -124,32 +124,6 @@ torch::Tensor SampleWindows(const GenDataset& dataset, int window, int batch,
   return (windows - mean) / std;
 }
 
-// Every sequence's codes (its frames cut to a multiple of the token length).
-std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
-                                                  const GenDataset& dataset,
-                                                  const torch::Tensor& mean,
-                                                  const torch::Tensor& std,
-                                                  std::vector<int>* views) {
-  model->eval();
-  std::vector<std::vector<int64_t>> sequences;
-  views->clear();
-  const int per_token = model->frames_per_token();
-  for (const GenSequence& sequence : dataset.sequences) {
-    const int frames = sequence.num_frames / per_token * per_token;
-    if (frames == 0) continue;
-    torch::Tensor x =
-        torch::from_blob(const_cast<float*>(sequence.features.data()),
-                         {1, frames, dataset.frame_size})
-            .clone();
-    torch::Tensor tokens = model->Encode((x - mean) / std).reshape({-1});
-    sequences.emplace_back(tokens.data_ptr<int64_t>(),
-                           tokens.data_ptr<int64_t>() + tokens.numel());
-    views->push_back(sequence.view);
-  }
-  model->train();
-  return sequences;
-}
-
 // Linear warm-up over the first 5 % of steps (at most 1000), then the full
 // rate until 2/3 of the steps, then a tenth of it (T2M-GPT's schedule,
 // shortened).

@@ -83,6 +83,8 @@ std::string GeneratorEvalResult::BriefReport() const {
       << "; mean |error|: local pose " << reconstruction_pose_error
       << ", root step " << reconstruction_root_error << ", log-scale step "
       << reconstruction_scale_error << " (units of the body's scale)\n"
+      << "FID of the real codes decoded as a stream vs real "
+      << fid_stream_reconstruction << "\n"
       << "diversity real " << diversity_real << ", generated "
       << diversity_generated << "\n"
       << "windows: real " << real_windows << ", held apart "
@@ -179,6 +181,27 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     result.fid_reconstruction =
         FrechetDistance(FitFeatureGaussian(EncodeWindows(encoder, decoded)),
                         FitFeatureGaussian(real_features));
+  }
+
+  // The streaming decoder alone: the codes the prior learns (every real
+  // sequence encoded whole) decoded as a generation's are.
+  {
+    std::vector<int> views;
+    const std::vector<std::vector<int64_t>> code_sequences = TokenizeDataset(
+        tokenizer.model, real, tokenizer.mean, tokenizer.std, &views);
+    std::vector<GenSequence> streamed;
+    for (size_t i = 0; i < code_sequences.size(); ++i) {
+      MotionStream stream(tokenizer, code_sequences[i], options.generation);
+      const int64_t frames = stream.frames_available();
+      std::vector<float> rows;
+      while (static_cast<int64_t>(rows.size()) < frames * frame_size)
+        stream.Next(&rows);
+      streamed.push_back({"streamed/" + std::to_string(i),
+                          static_cast<int>(frames), std::move(rows)});
+    }
+    result.fid_stream_reconstruction = FrechetDistance(
+        FitFeatureGaussian(EncodeWindows(encoder, windows_of(streamed))),
+        FitFeatureGaussian(real_features));
   }
 
   // The floors at the generations' sample size: as many real stretches as

@@ -68,6 +68,11 @@ struct GeneratorEvalResult {
   double fid = 0.0;           // generated vs real
   // The tokenizer alone: every real window encoded and decoded.
   double fid_reconstruction = 0.0;
+  // The streaming decoder alone: every real sequence's codes, encoded whole
+  // as the prior learns them, decoded as a generation's are
+  // (MotionStream's replay; options.generation's decoding and anchor). The
+  // floor a perfect prior's generations would score.
+  double fid_stream_reconstruction = 0.0;
   // Its mean |error| per channel group of X^can (body-scale units).
   double reconstruction_pose_error = 0.0, reconstruction_root_error = 0.0,
          reconstruction_scale_error = 0.0;

@@ -9,7 +9,8 @@ namespace m2d {
 MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                            const GenerationOptions& options)
     : tokenizer_(std::move(tokenizer)),
-      sampler_(prior.model, options.sampling, options.seed, options.view),
+      sampler_(std::in_place, prior.model, options.sampling, options.seed,
+               options.view),
       options_(options),
       anchor_(options.placement_return_s, tokenizer_.config.data.fps) {
   if (prior.model->num_codes() != tokenizer_.model->num_codes()) {
@@ -19,6 +20,26 @@ MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                       std::to_string(tokenizer_.model->num_codes()) +
                       ": they come from different runs");
   }
+  CheckDecoding();
+}
+
+MotionStream::MotionStream(LoadedTokenizer tokenizer,
+                           std::vector<int64_t> codes,
+                           const GenerationOptions& options)
+    : tokenizer_(std::move(tokenizer)),
+      replayed_codes_(std::move(codes)),
+      options_(options),
+      anchor_(options.placement_return_s, tokenizer_.config.data.fps) {
+  for (int64_t code : replayed_codes_) {
+    if (code < 0 || code >= tokenizer_.model->num_codes())
+      throw ConfigError("stream: replayed code " + std::to_string(code) +
+                        " is not one of the tokenizer's " +
+                        std::to_string(tokenizer_.model->num_codes()));
+  }
+  CheckDecoding();
+}
+
+void MotionStream::CheckDecoding() {
   const StreamDecoding& decoding = options_.decoding;
   if (decoding.lookahead_codes < 0 || decoding.emit_codes < 1 ||
       decoding.context_codes < decoding.lookahead_codes + decoding.emit_codes)
@@ -26,6 +47,27 @@ MotionStream::MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
         "stream: lookahead_codes must be >= 0, emit_codes >= 1 and "
         "context_codes >= lookahead_codes + emit_codes");
   tokenizer_.model->eval();
+}
+
+bool MotionStream::HaveCodes(int64_t end) {
+  if (!sampler_) return static_cast<int64_t>(replayed_codes_.size()) >= end;
+  while (static_cast<int64_t>(sampler_->codes().size()) < end) sampler_->Next();
+  return true;
+}
+
+int64_t MotionStream::frames_available() const {
+  if (sampler_) return 0;
+  // Whole decodings of emit_codes codes, each needing its lookahead after
+  // it, then the frames of the current decoding not yet emitted.
+  const StreamDecoding& decoding = options_.decoding;
+  const int64_t usable = static_cast<int64_t>(replayed_codes_.size()) -
+                         decoding.lookahead_codes - emitted_codes_;
+  const int64_t pending = static_cast<int64_t>(decoded_.size() / frame_size()) -
+                          static_cast<int64_t>(next_decoded_row_);
+  const int64_t whole =
+      std::max<int64_t>(0, usable - pending / frames_per_token()) /
+      decoding.emit_codes * decoding.emit_codes;
+  return pending + whole * frames_per_token();
 }
 
 void MotionStream::Next(std::vector<float>* rows) {
@@ -40,8 +82,10 @@ void MotionStream::Next(std::vector<float>* rows) {
     const StreamDecoding& decoding = options_.decoding;
     const int64_t end =
         emitted_codes_ + decoding.emit_codes + decoding.lookahead_codes;
-    while (static_cast<int64_t>(sampler_.codes().size()) < end) sampler_.Next();
-    const std::vector<int64_t>& codes = sampler_.codes();
+    if (!HaveCodes(end))
+      throw ConfigError("stream: the replayed codes end before code " +
+                        std::to_string(end));
+    const std::vector<int64_t>& codes = this->codes();
     // Codes [begin, end) are decoded.
     const int64_t begin = std::max<int64_t>(0, end - decoding.context_codes);
     torch::Tensor window =

@@ -5,6 +5,7 @@
 #define MIMIC2D_GEN_MOTION_STREAM_H_
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "gen/gen_checkpoint.h"
@@ -22,6 +23,13 @@ class MotionStream {
  public:
   MotionStream(LoadedTokenizer tokenizer, LoadedPrior prior,
                const GenerationOptions& options);
+  // Replays given codes (e.g. a real sequence's, TokenizeDataset) through
+  // the same decoding instead of drawing them: what the streaming decoder
+  // alone does to real motion. Next() throws ConfigError once the codes
+  // left cannot fill a decoding; frames_available() says how many can be
+  // emitted. options.sampling, seed and view are not used.
+  MotionStream(LoadedTokenizer tokenizer, std::vector<int64_t> codes,
+               const GenerationOptions& options);
 
   // Appends frames_per_token() rows of X^can (not normalized; rows of
   // CanonicalFeatures) to `rows`.
@@ -29,11 +37,20 @@ class MotionStream {
 
   int frames_per_token() const { return tokenizer_.model->frames_per_token(); }
   int frame_size() const { return tokenizer_.model->frame_size(); }
-  const std::vector<int64_t>& codes() const { return sampler_.codes(); }
+  const std::vector<int64_t>& codes() const {
+    return sampler_ ? sampler_->codes() : replayed_codes_;
+  }
+  // Replaying: the frames Next() can still emit in all (0 when drawing).
+  int64_t frames_available() const;
 
  private:
+  void CheckDecoding();  // ConfigError for bad decoding options; eval mode
+  // The codes up to `end` exist: drawn, or, replaying, there.
+  bool HaveCodes(int64_t end);
+
   LoadedTokenizer tokenizer_;
-  TokenSampler sampler_;
+  std::optional<TokenSampler> sampler_;  // empty: replaying
+  std::vector<int64_t> replayed_codes_;
   GenerationOptions options_;
   PlacementAnchor anchor_;  // holds the emitted rows' placement
   int64_t emitted_codes_ = 0;

@@ -221,4 +221,31 @@ VqVaeLosses ComputeVqVaeLosses(const torch::Tensor& reconstruction,
   return losses;
 }
 
+std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
+                                                  const GenDataset& dataset,
+                                                  const torch::Tensor& mean,
+                                                  const torch::Tensor& std,
+                                                  std::vector<int>* views) {
+  torch::NoGradGuard no_grad;
+  const bool was_training = model->is_training();
+  model->eval();
+  std::vector<std::vector<int64_t>> sequences;
+  views->clear();
+  const int per_token = model->frames_per_token();
+  for (const GenSequence& sequence : dataset.sequences) {
+    const int frames = sequence.num_frames / per_token * per_token;
+    if (frames == 0) continue;
+    torch::Tensor x =
+        torch::from_blob(const_cast<float*>(sequence.features.data()),
+                         {1, frames, dataset.frame_size})
+            .clone();
+    torch::Tensor tokens = model->Encode((x - mean) / std).reshape({-1});
+    sequences.emplace_back(tokens.data_ptr<int64_t>(),
+                           tokens.data_ptr<int64_t>() + tokens.numel());
+    views->push_back(sequence.view);
+  }
+  model->train(was_training);
+  return sequences;
+}
+
 }  // namespace m2d

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gen/gen_config.h"
+#include "gen/motion_dataset.h"
 
 namespace m2d {
 
@@ -117,6 +118,16 @@ VqVaeLosses ComputeVqVaeLosses(const torch::Tensor& reconstruction,
                                const torch::Tensor& mean,
                                const torch::Tensor& std, int num_keypoints,
                                const VqVaeOptions& options);
+
+// Every sequence's codes, each sequence encoded whole (its frames cut to a
+// multiple of the token length; normalized by `mean`, `std`), in eval mode
+// (the model's mode is restored after); `views` gets each kept sequence's view.
+// The prior learns these codes.
+std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
+                                                  const GenDataset& dataset,
+                                                  const torch::Tensor& mean,
+                                                  const torch::Tensor& std,
+                                                  std::vector<int>* views);
 
 }  // namespace m2d
 

@@ -175,13 +175,13 @@ TEST(MeasureFitAccuracy, TruthBeyondTheJointRangesHasAReachableFloor) {
   GroundTruth3D& truth = *bundle.ground_truth;
   for (size_t t = 0; t < truth.poses.size(); ++t) {
     Pose3D& pose = truth.poses[t];
-    pose.local_rotations[left_hip] =
-        Eigen::Quaterniond(Eigen::AngleAxisd(100 * kDeg, Eigen::Vector3d::UnitX()));
+    pose.local_rotations[left_hip] = Eigen::Quaterniond(
+        Eigen::AngleAxisd(100 * kDeg, Eigen::Vector3d::UnitX()));
     truth.keypoints_m[t] = KeypointPositions(character->skeleton(),
                                              character->keypoint_map(), pose);
   }
-  const FitAccuracy accuracy = MeasureFitAccuracy(
-      estimate, bundle.views[0].cameras, truth, *character);
+  const FitAccuracy accuracy =
+      MeasureFitAccuracy(estimate, bundle.views[0].cameras, truth, *character);
   EXPECT_GT(accuracy.reachable_pa_mpjpe_mm, 20.0);
   EXPECT_LT(accuracy.reachable_pa_mpjpe_mm, accuracy.pa_mpjpe_mm);
 }
@@ -247,6 +247,30 @@ TEST(FitBenchmarkOptions, AnUnknownClipIsNamed) {
   EXPECT_EQ(options.num_views, 1);
   options.num_views = 0;
   EXPECT_THROW(options.Validate(), ConfigError);
+}
+
+TEST(FitBenchmarkOptions, LoopingClipsAreRepeatedToTheMinimumLength) {
+  FitBenchmarkOptions options;
+  options.motion_dir = SourcePath("assets/motions/deepmimic");
+  auto character =
+      LoadCharacterForSimulation(SourcePath("assets/characters/humanoid.yaml"),
+                                 "flat", SimulationOptions());
+  const FitCameraSetting setting = DefaultFitCameraSettings()[1];
+  auto frames = [&](const std::string& clip) {
+    const Motion3D motion = ReadDeepMimicMotion(options.MotionPath(clip),
+                                                character->shared_skeleton());
+    return MakeBenchmarkBundle(motion, *character, options, setting, false,
+                               clip)
+        .views[0]
+        .clip.num_frames();
+  };
+  const int walk = frames("walk"), kick = frames("kick");
+  EXPECT_LT(walk, 45);  // a 1.3-s cycle at 30 Hz
+  options.min_duration_s = 3.0;
+  EXPECT_EQ(frames("walk"), 91);    // looped to 3 s
+  EXPECT_EQ(frames("kick"), kick);  // played once: its own length
+  options.max_duration_s = 2.0;
+  EXPECT_THROW(options.Validate(), ConfigError);  // longer than the cut
 }
 
 TEST(FitBenchmarkTable, HasARowPerCombinationAndTheMeans) {

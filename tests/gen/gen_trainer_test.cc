@@ -201,6 +201,41 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
       ConfigError);
 }
 
+// Replayed, a stream's codes decode to the frames the drawing stream
+// emitted (the eval's stream-reconstruction FID decodes real codes so), and
+// the replay says how many frames its codes hold and stops there.
+TEST(GenTrainer, ReplayedCodesDecodeAsTheDrawnOnes) {
+  const GenConfig config = TinyConfig(TempRun("replay"));
+  TrainGenerator(config, WalkDataset(), false, nullptr, nullptr);
+  GenerationOptions options;
+  options.seed = 5;
+  options.placement_return_s = 2.0;
+  MotionStream drawn(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                     LoadPrior(config.run.run_dir + "/prior.pt"), options);
+  std::vector<float> rows;
+  for (int i = 0; i < 12; ++i) drawn.Next(&rows);  // past the context
+  EXPECT_EQ(drawn.frames_available(), 0);          // drawing: no limit
+  // Decoding 4 codes at a time with 1 of lookahead: 12 emitted codes drew
+  // 13 (the third decoding needed codes 8..12).
+  ASSERT_EQ(drawn.codes().size(), 13u);
+  MotionStream replayed(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                        drawn.codes(), options);
+  EXPECT_EQ(replayed.frames_available(), 12 * 4);
+  std::vector<float> replayed_rows;
+  replayed.Next(&replayed_rows);
+  EXPECT_EQ(replayed.frames_available(), 11 * 4);
+  for (int i = 1; i < 12; ++i) replayed.Next(&replayed_rows);
+  ASSERT_EQ(replayed_rows.size(), rows.size());
+  for (size_t i = 0; i < rows.size(); ++i)
+    ASSERT_FLOAT_EQ(replayed_rows[i], rows[i]) << "row " << i / 37;
+  EXPECT_EQ(replayed.frames_available(), 0);
+  EXPECT_THROW(replayed.Next(&replayed_rows), ConfigError);
+  // A code the tokenizer does not have is refused.
+  EXPECT_THROW(MotionStream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                            std::vector<int64_t>{0, 3, 16}, options),
+               ConfigError);
+}
+
 // Streamed frame by frame, the generator gives the clip `generate` writes
 // for the same seed and placement: the same codes, decoded alike, turned
 // into absolute 2D by the same recurrence.
@@ -258,6 +293,8 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   EXPECT_GE(result.fid_floor_time, 0.0);
   EXPECT_GE(result.fid_floor_sampled, 0.0);
   EXPECT_GE(result.fid_floor_sampled_segment, 0.0);
+  EXPECT_TRUE(std::isfinite(result.fid_stream_reconstruction));
+  EXPECT_GE(result.fid_stream_reconstruction, 0.0);
   EXPECT_TRUE(std::isfinite(result.fid_floor_sampled));
   // Real data with sequences shorter than a window (a clip played once):
   // the floors draw among those that hold one, as the real windows do.
