@@ -129,6 +129,7 @@ struct GenerateArgs {
   double seconds = 10.0;
   GenerationOptions generation;                  // --seed, sampling, placement
   std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
+  int motion = 0;  // data.motions index, for a prior conditioned on it
   double focal_px = 1000.0;
   // --policy: a tracker checkpoint driven along `generations` streams
   // (seeds seed, seed + 1, ...); --video: the first one drawn.
@@ -262,8 +263,8 @@ std::vector<TrackedSource> TrackedSources(const GenerateArgs& args) {
       GeneratedStreamOptions options;
       options.generation = args.generation;
       options.generation.seed = args.generation.seed + g;
-      options.generation.view =
-          GenerationView(generator_config, azimuth_deg, args.view[1]);
+      options.generation.view = GenerationView(generator_config, azimuth_deg,
+                                               args.view[1], args.motion);
       options.first_root_px = root_px;
       options.first_scale_px = scale_px;
       options.image_width_px = view_camera.intrinsics().width_px;
@@ -456,14 +457,20 @@ int RunGenerate(const GenerateArgs& args) {
   // --view.
   const GenConfig config = ReadPriorConfig(args.run_dir);
   GenerationOptions generation = args.generation;
-  const int view = GenerationView(config, args.view[0], args.view[1]);
-  generation.view = view;
-  if (view >= 0) {
+  const int condition =
+      GenerationView(config, args.view[0], args.view[1], args.motion);
+  generation.view = condition;
+  if (condition >= 0) {
+    const int view = condition % config.prior_views();
     std::printf(
         "generating the data's view %d (azimuth %.0f deg, elevation "
-        "%.0f deg), the nearest to --view\n",
+        "%.0f deg), the nearest to --view%s%s\n",
         view, config.data.views.azimuth_deg(view),
-        config.data.views.elevation_deg(view));
+        config.data.views.elevation_deg(view),
+        config.prior.condition_on_motion ? ", of motion " : "",
+        config.prior.condition_on_motion
+            ? config.data.motions[args.motion].c_str()
+            : "");
   }
   const GeneratedMotion motion =
       GenerateMotion(args.run_dir, args.seconds, generation);
@@ -536,6 +543,12 @@ int RunGenEval(const GenEvalArgs& args) {
         {"placement_return_s", args.options.generation.placement_return_s},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},
+        {"neighbours", args.options.neighbours},
+        {"precision", result.precision},
+        {"recall", result.recall},
+        {"precision_floor_time", result.precision_floor_time},
+        {"recall_floor_time", result.recall_floor_time},
+        {"recall_by_motion", result.recall_by_motion},
         {"time_segments", args.options.time_segments},
         {"fid_by_time_segment", result.fid_by_time_segment},
         {"real_windows", result.real_windows},
@@ -660,6 +673,12 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Camera azimuth (deg), elevation (deg), distance (m)")
       ->delimiter(',')
       ->expected(3);
+  generate
+      ->add_option("--motion", generate_args->motion,
+                   "A prior conditioned on the motion (prior."
+                   "condition_on_motion): which of its config's data.motions "
+                   "to generate (from 0)")
+      ->capture_default_str();
   generate->add_option("--focal", generate_args->focal_px,
                        "Camera focal length (px)");
   generate

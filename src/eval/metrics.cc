@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace m2d {
@@ -186,6 +187,72 @@ double MeanPairDistance(const Eigen::MatrixXd& features, int pairs,
     sum += (features.row(i) - features.row(j)).norm();
   }
   return sum / pairs;
+}
+
+namespace {
+
+// Squared distances between every row of `a` and every row of `b` (as
+// |a|^2 + |b|^2 - 2 a.b, floored at 0 against round-off), in blocks of
+// `a`'s rows, handed to `visit(first_row, block)`: a full matrix of two
+// 12k-row sets would take a gigabyte.
+template <typename Visit>
+void ForEachDistanceBlock(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                          Visit visit) {
+  constexpr int kBlockRows = 512;
+  const Eigen::VectorXd b_norms = b.rowwise().squaredNorm();
+  for (int first = 0; first < a.rows(); first += kBlockRows) {
+    const int rows = std::min<int>(kBlockRows, a.rows() - first);
+    const Eigen::MatrixXd block_a = a.middleRows(first, rows);
+    Eigen::MatrixXd squared = -2.0 * block_a * b.transpose();
+    squared.colwise() += block_a.rowwise().squaredNorm();
+    squared.rowwise() += b_norms.transpose();
+    visit(first, squared.cwiseMax(0.0));
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd KthNeighbourDistances(const Eigen::MatrixXd& rows, int k) {
+  Eigen::VectorXd radii = Eigen::VectorXd::Constant(
+      rows.rows(), std::numeric_limits<double>::infinity());
+  if (k < 1 || rows.rows() <= k) return radii;
+  std::vector<double> row_distances(rows.rows());
+  ForEachDistanceBlock(
+      rows, rows, [&](int first, const Eigen::MatrixXd& block) {
+        for (int r = 0; r < block.rows(); ++r) {
+          for (int c = 0; c < block.cols(); ++c) row_distances[c] = block(r, c);
+          // Itself (distance 0) is the nearest: the k-th other is element k.
+          std::nth_element(row_distances.begin(), row_distances.begin() + k,
+                           row_distances.end());
+          radii(first + r) = std::sqrt(row_distances[k]);
+        }
+      });
+  return radii;
+}
+
+double ShareWithinRadii(const Eigen::MatrixXd& samples,
+                        const Eigen::MatrixXd& set,
+                        const Eigen::VectorXd& radii) {
+  if (samples.rows() == 0) return 0.0;
+  const Eigen::RowVectorXd squared_radii =
+      radii.cwiseProduct(radii).transpose();
+  int within = 0;
+  ForEachDistanceBlock(samples, set, [&](int, const Eigen::MatrixXd& block) {
+    for (int r = 0; r < block.rows(); ++r)
+      within += ((block.row(r) - squared_radii).array() <= 0.0).any();
+  });
+  return static_cast<double>(within) / samples.rows();
+}
+
+PrecisionRecall ManifoldPrecisionRecall(const Eigen::MatrixXd& real,
+                                        const Eigen::MatrixXd& generated,
+                                        int k) {
+  PrecisionRecall result;
+  result.precision =
+      ShareWithinRadii(generated, real, KthNeighbourDistances(real, k));
+  result.recall =
+      ShareWithinRadii(real, generated, KthNeighbourDistances(generated, k));
+  return result;
 }
 
 }  // namespace m2d

@@ -74,6 +74,28 @@ double FrechetDistance(const FeatureGaussian& a, const FeatureGaussian& b);
 double MeanPairDistance(const Eigen::MatrixXd& features, int pairs,
                         uint64_t seed);
 
+// Improved precision and recall (Kynkaanniemi et al., NeurIPS 2019): a
+// sample lies on a set's manifold when it is within some member's distance
+// to that member's k-th nearest neighbour in the set. Precision: the share
+// of generated rows on the real manifold (are they like real ones?);
+// recall: the share of real rows on the generated manifold (is every kind
+// of real one generated?). FID mixes the two; a generator that repeats a
+// few real motions well has high precision and low recall.
+struct PrecisionRecall {
+  double precision = 0.0;
+  double recall = 0.0;
+};
+// Each row's Euclidean distance to its k-th nearest other row (k >= 1;
+// infinity when the set has no k other rows).
+Eigen::VectorXd KthNeighbourDistances(const Eigen::MatrixXd& rows, int k);
+// The share of `samples` rows within `radii`(i) of some row i of `set`.
+double ShareWithinRadii(const Eigen::MatrixXd& samples,
+                        const Eigen::MatrixXd& set,
+                        const Eigen::VectorXd& radii);
+PrecisionRecall ManifoldPrecisionRecall(const Eigen::MatrixXd& real,
+                                        const Eigen::MatrixXd& generated,
+                                        int k);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_EVAL_METRICS_H_

@@ -114,7 +114,7 @@ LoadedPrior LoadPrior(const std::string& path) {
   LoadedPrior loaded;
   loaded.config = ReadEmbeddedConfig(path, archive);
   loaded.model = Gpt(loaded.config.tokenizer.num_codes, loaded.config.prior,
-                     loaded.config.prior_views());
+                     loaded.config.prior_conditions());
   ReadModel(path, archive, *loaded.model);
   loaded.model->eval();
   return loaded;

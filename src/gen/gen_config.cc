@@ -36,6 +36,10 @@ void GenConfig::Validate() const {
   data.Validate();
   tokenizer.Validate();
   prior.Validate();
+  if (prior.condition_on_motion && !prior.condition_on_view)
+    throw ConfigError(
+        "prior.condition_on_motion needs prior.condition_on_view (the token "
+        "names a view and a motion)");
   CheckRanges(run, "run");
   if (run.run_dir.empty()) throw ConfigError("run.run_dir is empty");
   if (run.adapt_torch_threads && run.torch_threads < 2)

@@ -118,6 +118,11 @@ struct GptOptions {
   // from (T2M-GPT's slot 0, which holds its text): generation is asked for
   // a view and cannot drift into another one.
   bool condition_on_view = false;
+  // The token names the motion as well (one per view and motion of
+  // data.motions): a stream stays in the motion it began as, and the
+  // generations are spread over the motions as the data's frames are
+  // (docs/generation.md, "Coverage"). Needs condition_on_view.
+  bool condition_on_motion = false;
   int batch_size = 64;
   double learning_rate = 2e-4;  // AdamW
   int64_t steps = 20000;
@@ -136,6 +141,8 @@ struct GptOptions {
       "input tokens kept (others replaced by random codes)");
     v("condition_on_view", self.condition_on_view, Range::Any(),
       "windows open with a token naming the data's view");
+    v("condition_on_motion", self.condition_on_motion, Range::Any(),
+      "the token names the view and the motion (needs condition_on_view)");
     v("batch_size", self.batch_size, Range::Closed(1, 100000),
       "token windows per gradient step");
     v("learning_rate", self.learning_rate, Range::Above(0), "AdamW rate");
@@ -224,6 +231,18 @@ struct GenConfig {
   // conditioned on them, else 0.
   int prior_views() const {
     return prior.condition_on_view ? data.views.num_views() : 0;
+  }
+  // Motions the condition token names: data.motions when conditioned on
+  // them, else 1 (the token names the view alone).
+  int prior_motions() const {
+    return prior.condition_on_motion ? static_cast<int>(data.motions.size())
+                                     : 1;
+  }
+  // Condition tokens of the prior's vocabulary, and the one of a view and
+  // motion (motion 0 when not conditioned on it).
+  int prior_conditions() const { return prior_views() * prior_motions(); }
+  int PriorCondition(int view, int motion) const {
+    return view + prior_views() * (prior.condition_on_motion ? motion : 0);
   }
   void Validate() const;  // throws ConfigError naming the setting
 };

@@ -436,13 +436,19 @@ GenTrainSummary TrainGenerator(
     summary.interrupted = true;
     return summary;
   }
-  // 2. Every sequence as codes.
-  std::vector<int> views;
+  // 2. Every sequence as codes, and the condition each is read under.
+  std::vector<int> kept;
   const std::vector<std::vector<int64_t>> token_sequences =
-      TokenizeDataset(tokenizer, dataset, context.mean, context.std, &views);
+      TokenizeDataset(tokenizer, dataset, context.mean, context.std, &kept);
+  std::vector<int> views;  // condition indices (prior_conditions())
+  for (int index : kept) {
+    const GenSequence& sequence = dataset.sequences[index];
+    views.push_back(config.PriorCondition(sequence.view, sequence.motion));
+  }
   // 3. The prior, on the codes.
   torch::manual_seed(config.run.seed + 1);
-  Gpt prior(config.tokenizer.num_codes, config.prior, config.prior_views());
+  Gpt prior(config.tokenizer.num_codes, config.prior,
+            config.prior_conditions());
   GenStageState prior_state;
   summary.prior_loss =
       TrainPrior(context, resume, token_sequences, views, prior, &prior_state);

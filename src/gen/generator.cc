@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <sstream>
 
 #include "common/error.h"
@@ -65,9 +66,15 @@ GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
 }
 
 int GenerationView(const GenConfig& config, double azimuth_deg,
-                   double elevation_deg) {
+                   double elevation_deg, int motion) {
+  if (motion < 0 || motion >= config.prior_motions())
+    throw ConfigError("generate: --motion " + std::to_string(motion) +
+                      " is not one of the prior's " +
+                      std::to_string(config.prior_motions()) +
+                      " motion(s) (data.motions, from 0)");
   if (config.prior_views() == 0) return -1;
-  return config.data.views.NearestView(azimuth_deg, elevation_deg);
+  return config.PriorCondition(
+      config.data.views.NearestView(azimuth_deg, elevation_deg), motion);
 }
 
 std::string GeneratorEvalResult::BriefReport() const {
@@ -87,6 +94,12 @@ std::string GeneratorEvalResult::BriefReport() const {
       << fid_stream_reconstruction << "\n"
       << "diversity real " << diversity_real << ", generated "
       << diversity_generated << "\n"
+      << "precision " << precision << ", recall " << recall
+      << " (real halves in time: " << precision_floor_time << ", "
+      << recall_floor_time << "); recall by motion:";
+  for (const auto& [motion, motion_recall] : recall_by_motion)
+    out << " " << motion << " " << motion_recall;
+  out << "\n"
       << "windows: real " << real_windows << ", held apart "
       << held_apart_windows << " (encoder loss " << encoder_loss
       << "), generated " << generated_windows << "\n"
@@ -114,6 +127,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       options.seconds * real.fps / std::max(1, options.time_segments));
   if (options.floor_draws < 1)
     throw ConfigError("gen eval: floor_draws must be at least 1");
+  if (options.neighbours < 1)
+    throw ConfigError("gen eval: neighbours (k) must be at least 1");
   if (options.time_segments < 1 || segment_frames < options.window_frames) {
     throw ConfigError(
         "gen eval: " + std::to_string(options.time_segments) +
@@ -145,10 +160,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   const torch::Tensor real_windows = windows_of(real.sequences);
   result.real_windows = static_cast<int>(real_windows.size(0));
   const Eigen::MatrixXd real_features = EncodeWindows(encoder, real_windows);
-  auto halves_fid = [&](const std::vector<GenSequence>(&half)[2]) {
-    return FrechetDistance(
-        FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[0]))),
-        FitFeatureGaussian(EncodeWindows(encoder, windows_of(half[1]))));
+  auto features_of = [&](const std::vector<GenSequence>& sequences) {
+    return EncodeWindows(encoder, windows_of(sequences));
   };
   {
     std::vector<GenSequence> by_view[2], by_time[2];
@@ -159,8 +172,17 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       by_time[0].push_back(first);
       by_time[1].push_back(second);
     }
-    result.fid_floor_views = halves_fid(by_view);
-    result.fid_floor_time = halves_fid(by_time);
+    result.fid_floor_views =
+        FrechetDistance(FitFeatureGaussian(features_of(by_view[0])),
+                        FitFeatureGaussian(features_of(by_view[1])));
+    const Eigen::MatrixXd first_half = features_of(by_time[0]),
+                          second_half = features_of(by_time[1]);
+    result.fid_floor_time = FrechetDistance(FitFeatureGaussian(first_half),
+                                            FitFeatureGaussian(second_half));
+    const PrecisionRecall halves =
+        ManifoldPrecisionRecall(first_half, second_half, options.neighbours);
+    result.precision_floor_time = halves.precision;
+    result.recall_floor_time = halves.recall;
   }
 
   // The tokenizer alone: every real window encoded and decoded (windows
@@ -186,9 +208,9 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   // The streaming decoder alone: the codes the prior learns (every real
   // sequence encoded whole) decoded as a generation's are.
   {
-    std::vector<int> views;
+    std::vector<int> kept;
     const std::vector<std::vector<int64_t>> code_sequences = TokenizeDataset(
-        tokenizer.model, real, tokenizer.mean, tokenizer.std, &views);
+        tokenizer.model, real, tokenizer.mean, tokenizer.std, &kept);
     std::vector<GenSequence> streamed;
     for (size_t i = 0; i < code_sequences.size(); ++i) {
       MotionStream stream(tokenizer, code_sequences[i], options.generation);
@@ -236,10 +258,30 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   CheckGeneration(options.seconds, options.generation.sampling);
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
   const int views = prior.config.prior_views();
+  // A prior conditioned on the motion generates the motions in proportion
+  // to their frames in the data, stratified: generation g takes the motion
+  // whose share of the frames holds (g + 1/2) / generations.
+  std::vector<double> motion_frames(prior.config.prior_motions(), 0.0);
+  for (const GenSequence& sequence : real.sequences) {
+    if (prior.config.prior.condition_on_motion &&
+        sequence.motion < static_cast<int>(motion_frames.size()))
+      motion_frames[sequence.motion] += sequence.num_frames;
+  }
+  auto motion_of = [&](int g) {
+    double total = 0.0, cumulative = 0.0;
+    for (double frames : motion_frames) total += frames;
+    const double at = (g + 0.5) / options.generations * total;
+    for (size_t m = 0; m < motion_frames.size(); ++m) {
+      cumulative += motion_frames[m];
+      if (at < cumulative) return static_cast<int>(m);
+    }
+    return 0;
+  };
   for (int g = 0; g < options.generations; ++g) {
     GenerationOptions generation = options.generation;
     generation.seed = static_cast<uint64_t>(g + 1);
-    generation.view = views > 0 ? g % views : -1;
+    generation.view =
+        views > 0 ? prior.config.PriorCondition(g % views, motion_of(g)) : -1;
     GeneratedMotion motion =
         Generate(tokenizer, prior, options.seconds, generation);
     generation_s += motion.generation_s;
@@ -275,6 +317,29 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
             &result.drift_log_scale_real, &result.drift_root_real);
   result.fid =
       FrechetDistance(FitFeatureGaussian(generated_features), real_gaussian);
+  const PrecisionRecall coverage = ManifoldPrecisionRecall(
+      real_features, generated_features, options.neighbours);
+  result.precision = coverage.precision;
+  result.recall = coverage.recall;
+  {
+    // Each motion's windows alone on the generated manifold: which motions
+    // the generations leave out.
+    const Eigen::VectorXd generated_radii =
+        KthNeighbourDistances(generated_features, options.neighbours);
+    std::map<std::string, std::vector<GenSequence>> by_motion;
+    for (const GenSequence& sequence : real.sequences)
+      by_motion[sequence.name.substr(0, sequence.name.find('/'))].push_back(
+          sequence);
+    for (const auto& [motion, sequences] : by_motion) {
+      bool has_window = false;
+      for (const GenSequence& sequence : sequences)
+        has_window |= sequence.num_frames >= options.window_frames;
+      if (!has_window) continue;
+      result.recall_by_motion.push_back(
+          {motion, ShareWithinRadii(features_of(sequences), generated_features,
+                                    generated_radii)});
+    }
+  }
   result.diversity_real = MeanPairDistance(real_features, 300, options.seed);
   result.diversity_generated =
       MeanPairDistance(generated_features, 300, options.seed);

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gen/gen_config.h"
@@ -37,11 +38,13 @@ struct GeneratedMotion {
 GeneratedMotion GenerateMotion(const std::string& run_dir, double seconds,
                                const GenerationOptions& generation);
 
-// The data view a run's prior generates for a camera at `azimuth_deg`,
-// `elevation_deg`: the nearest of its views when it is conditioned on the
-// view, else -1.
+// The condition a run's prior generates for a camera at `azimuth_deg`,
+// `elevation_deg`: the nearest of the data's views when it is conditioned
+// on the view (and `motion`, an index into data.motions, when it is
+// conditioned on the motion too), else -1. ConfigError for a motion the
+// prior does not know.
 int GenerationView(const GenConfig& config, double azimuth_deg,
-                   double elevation_deg);
+                   double elevation_deg, int motion = 0);
 
 struct GeneratorEvalOptions {
   // Independent streams (seeds 1..N); a prior conditioned on the view
@@ -60,6 +63,7 @@ struct GeneratorEvalOptions {
   int time_segments = 4;
   // Draws of real stretches averaged in the sampled floors (below).
   int floor_draws = 5;
+  int neighbours = 3;  // k of precision and recall (the paper's default)
 };
 
 struct GeneratorEvalResult {
@@ -94,6 +98,14 @@ struct GeneratorEvalResult {
   double fid_floor_sampled = 0.0, fid_floor_sampled_segment = 0.0;
   double diversity_real = 0.0;  // mean feature distance of random pairs
   double diversity_generated = 0.0;
+  // Improved precision and recall (eval/metrics.h) of the generated windows
+  // against the real ones, and of the second halves in time against the
+  // first (what real motion that is not the same motion scores); the
+  // recall of each motion's windows alone (the part of a sequence's name
+  // before its first '/'), for the motions that hold a window.
+  double precision = 0.0, recall = 0.0;
+  double precision_floor_time = 0.0, recall_floor_time = 0.0;
+  std::vector<std::pair<std::string, double>> recall_by_motion;
   // FID vs real of the generated windows in each time segment (the k-th
   // part of every generation; equal window counts, so comparable with each
   // other, not with `fid`, which has more windows and less bias).

@@ -148,7 +148,8 @@ GenSequence FramesOf(const GenSequence& sequence, int frame_size, int begin,
           end - begin,
           {rows + static_cast<size_t>(begin) * frame_size,
            rows + static_cast<size_t>(end) * frame_size},
-          sequence.view};
+          sequence.view,
+          sequence.motion};
 }
 
 }  // namespace
@@ -288,7 +289,8 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
   dataset.fps = fps;
   dataset.frame_size = CanonicalFrameSize(*dataset.layout);
   dataset.num_views = views.num_views();
-  for (const GenMotionSource& source : motions) {
+  for (size_t motion_index = 0; motion_index < motions.size(); ++motion_index) {
+    const GenMotionSource& source = motions[motion_index];
     int view_index = 0;  // the order of GenViewOptions::azimuth_deg
     for (double elevation : views.elevations_deg) {
       BundleFromMotionOptions options;
@@ -315,6 +317,7 @@ GenDataset BuildGenDataset(const std::vector<GenMotionSource>& motions,
         sequence.num_frames = canonical.num_frames();
         sequence.features = CanonicalFeatures(canonical);
         sequence.view = view_index++;
+        sequence.motion = static_cast<int>(motion_index);
         dataset.sequences.push_back(std::move(sequence));
       }
     }

@@ -82,7 +82,8 @@ struct GenSequence {
   std::string name;  // "<motion>/<view>"
   int num_frames = 0;
   std::vector<float> features;  // num_frames rows of CanonicalFrameSize
-  int view = 0;  // which of GenViewOptions' views it is seen from
+  int view = 0;    // which of GenViewOptions' views it is seen from
+  int motion = 0;  // which of the dataset's motions it shows
 };
 
 struct GenDataset {

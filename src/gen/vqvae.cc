@@ -225,14 +225,15 @@ std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
                                                   const GenDataset& dataset,
                                                   const torch::Tensor& mean,
                                                   const torch::Tensor& std,
-                                                  std::vector<int>* views) {
+                                                  std::vector<int>* kept) {
   torch::NoGradGuard no_grad;
   const bool was_training = model->is_training();
   model->eval();
   std::vector<std::vector<int64_t>> sequences;
-  views->clear();
+  kept->clear();
   const int per_token = model->frames_per_token();
-  for (const GenSequence& sequence : dataset.sequences) {
+  for (size_t i = 0; i < dataset.sequences.size(); ++i) {
+    const GenSequence& sequence = dataset.sequences[i];
     const int frames = sequence.num_frames / per_token * per_token;
     if (frames == 0) continue;
     torch::Tensor x =
@@ -242,7 +243,7 @@ std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
     torch::Tensor tokens = model->Encode((x - mean) / std).reshape({-1});
     sequences.emplace_back(tokens.data_ptr<int64_t>(),
                            tokens.data_ptr<int64_t>() + tokens.numel());
-    views->push_back(sequence.view);
+    kept->push_back(static_cast<int>(i));
   }
   model->train(was_training);
   return sequences;

@@ -121,13 +121,14 @@ VqVaeLosses ComputeVqVaeLosses(const torch::Tensor& reconstruction,
 
 // Every sequence's codes, each sequence encoded whole (its frames cut to a
 // multiple of the token length; normalized by `mean`, `std`), in eval mode
-// (the model's mode is restored after); `views` gets each kept sequence's view.
-// The prior learns these codes.
+// (the model's mode is restored after); `kept` gets the index in
+// dataset.sequences of each sequence long enough for a code. The prior
+// learns these codes.
 std::vector<std::vector<int64_t>> TokenizeDataset(VqVae& model,
                                                   const GenDataset& dataset,
                                                   const torch::Tensor& mean,
                                                   const torch::Tensor& std,
-                                                  std::vector<int>* views);
+                                                  std::vector<int>* kept);
 
 }  // namespace m2d
 

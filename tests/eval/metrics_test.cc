@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -362,6 +363,41 @@ TEST(Metrics, FeatureGaussianAndPairDistance) {
   EXPECT_LT(mean, 2.0 * std::sqrt(2.0));
   EXPECT_NEAR(mean, (4 * 2.0 + 2 * 2.0 * std::sqrt(2.0)) / 6, 0.05);
   EXPECT_EQ(MeanPairDistance(rows.topRows(1), 10, 1), 0.0);
+}
+
+TEST(Metrics, PrecisionAndRecallTellFaithfulFromCovering) {
+  // Real: two clusters of 200 points. Generated: cluster A alone, then A
+  // and B, then points far from both.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  auto cluster = [&](double x, int count) {
+    Eigen::MatrixXd rows(count, 2);
+    for (int i = 0; i < count; ++i) rows.row(i) << x + noise(rng), noise(rng);
+    return rows;
+  };
+  Eigen::MatrixXd real(400, 2);
+  real << cluster(0.0, 200), cluster(5.0, 200);
+  const PrecisionRecall only_a =
+      ManifoldPrecisionRecall(real, cluster(0.0, 300), 3);
+  EXPECT_GT(only_a.precision, 0.95);
+  EXPECT_NEAR(only_a.recall, 0.5, 0.05);
+  Eigen::MatrixXd both(400, 2);
+  both << cluster(0.0, 200), cluster(5.0, 200);
+  const PrecisionRecall covering = ManifoldPrecisionRecall(real, both, 3);
+  EXPECT_GT(covering.precision, 0.95);
+  EXPECT_GT(covering.recall, 0.95);
+  const PrecisionRecall far =
+      ManifoldPrecisionRecall(real, cluster(20.0, 300), 3);
+  EXPECT_EQ(far.precision, 0.0);
+  EXPECT_EQ(far.recall, 0.0);
+  // The k-th neighbour distance: on a line of points 1 apart, the 2nd
+  // nearest other point of an end is 2 away, of an inner point 1.
+  Eigen::MatrixXd line(5, 1);
+  line << 0, 1, 2, 3, 4;
+  const Eigen::VectorXd radii = KthNeighbourDistances(line, 2);
+  EXPECT_DOUBLE_EQ(radii(0), 2.0);
+  EXPECT_DOUBLE_EQ(radii(2), 1.0);
+  EXPECT_TRUE(std::isinf(KthNeighbourDistances(line, 5)(0)));
 }
 
 }  // namespace

@@ -385,6 +385,49 @@ TEST(GenTrainer, AViewConditionedPriorGeneratesTheViewAskedFor) {
                         .fid));
 }
 
+TEST(GenTrainer, AMotionConditionedPriorHasATokenPerViewAndMotion) {
+  // The walk and the run from 2 azimuths at 10 deg: the condition token
+  // names a view and a motion (view + views x motion), generation asks
+  // for one of each, and the evaluation spreads its generations over the
+  // motions.
+  GenViewOptions views;
+  views.num_azimuths = 2;
+  views.elevations_deg = {10};
+  const GenDataset dataset = BuildGenDataset(
+      {testing::DeepMimicSource("walk"), testing::DeepMimicSource("run")},
+      views, 30.0, 4.0);
+  ASSERT_EQ(dataset.sequences.size(), 4u);
+  EXPECT_EQ(dataset.sequences[1].motion, 0);
+  EXPECT_EQ(dataset.sequences[2].motion, 1);
+  EXPECT_EQ(dataset.sequences[2].view, 0);
+  GenConfig config = TinyConfig(TempRun("motion"));
+  config.data.views = views;
+  config.data.motions = {"assets/motions/deepmimic/humanoid3d_walk.txt",
+                         "assets/motions/deepmimic/humanoid3d_run.txt"};
+  config.prior.condition_on_motion = true;
+  EXPECT_THROW(config.Validate(), ConfigError);  // needs the view's token
+  config.prior.condition_on_view = true;
+  config.Validate();
+  EXPECT_EQ(config.prior_conditions(), 4);
+  EXPECT_EQ(config.PriorCondition(1, 1), 3);
+  TrainGenerator(config, dataset, false, nullptr, nullptr);
+  const LoadedPrior prior = LoadPrior(config.run.run_dir + "/prior.pt");
+  EXPECT_EQ(prior.model->num_views(), 4);
+  EXPECT_EQ(GenerationView(config, 200, 0, 1), 3);
+  EXPECT_EQ(GenerationView(config, 30, 0, 0), 0);
+  EXPECT_THROW(GenerationView(config, 30, 0, 2), ConfigError);
+  EXPECT_THROW(GenerationView(TinyConfig("unconditioned"), 30, 0, 1),
+               ConfigError);
+  GenerationOptions generation;
+  generation.view = 3;
+  const GeneratedMotion motion =
+      GenerateMotion(config.run.run_dir, 2.0, generation);
+  EXPECT_EQ(motion.num_frames, 60);
+  EXPECT_TRUE(std::isfinite(EvaluateGenerator(config.run.run_dir, dataset,
+                                              dataset, TinyEvalOptions(2.0, 1))
+                                .fid));
+}
+
 TEST(GenTrainer, ADamagedCheckpointIsNamed) {
   const std::string dir = TempRun("damaged");
   std::filesystem::create_directories(dir);
