@@ -413,6 +413,15 @@ GenTrainSummary TrainGenerator(
                       " views but the config's data names " +
                       std::to_string(config.prior_views()) +
                       " (prior.condition_on_view needs them to agree)");
+  for (const GenSequence& sequence : dataset.sequences) {
+    if (config.prior.condition_on_motion &&
+        sequence.motion >= config.prior_motions())
+      throw ConfigError("gen train: sequence " + sequence.name +
+                        " shows motion " + std::to_string(sequence.motion) +
+                        " but the config's data names " +
+                        std::to_string(config.prior_motions()) +
+                        " (prior.condition_on_motion needs them to agree)");
+  }
   torch::set_num_threads(config.run.torch_threads);
   std::filesystem::create_directories(config.run.run_dir);
   const StageContext context{config,

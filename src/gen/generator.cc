@@ -267,10 +267,11 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
         sequence.motion < static_cast<int>(motion_frames.size()))
       motion_frames[sequence.motion] += sequence.num_frames;
   }
+  double total_frames = 0.0;
+  for (double frames : motion_frames) total_frames += frames;
   auto motion_of = [&](int g) {
-    double total = 0.0, cumulative = 0.0;
-    for (double frames : motion_frames) total += frames;
-    const double at = (g + 0.5) / options.generations * total;
+    double cumulative = 0.0;
+    const double at = (g + 0.5) / options.generations * total_frames;
     for (size_t m = 0; m < motion_frames.size(); ++m) {
       cumulative += motion_frames[m];
       if (at < cumulative) return static_cast<int>(m);

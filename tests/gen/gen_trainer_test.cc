@@ -410,6 +410,12 @@ TEST(GenTrainer, AMotionConditionedPriorHasATokenPerViewAndMotion) {
   config.Validate();
   EXPECT_EQ(config.prior_conditions(), 4);
   EXPECT_EQ(config.PriorCondition(1, 1), 3);
+  {  // A dataset of more motions than the config names is refused.
+    GenConfig one_motion = config;
+    one_motion.data.motions.resize(1);
+    EXPECT_THROW(TrainGenerator(one_motion, dataset, false, nullptr, nullptr),
+                 ConfigError);
+  }
   TrainGenerator(config, dataset, false, nullptr, nullptr);
   const LoadedPrior prior = LoadPrior(config.run.run_dir + "/prior.pt");
   EXPECT_EQ(prior.model->num_views(), 4);
