@@ -2,12 +2,14 @@
 # The walk family for the generator's tracker (issue 16, docs/generation.md
 # "The tracker fed by the stream"): the long DeepMimic walks the generator
 # learns from (configs/gen/walks.yaml), each seen by 4 cameras that follow
-# the walker (elevation 10 deg, 4.5 m, focal 1000 px, as the walk2d
-# policy's bundle), stripped to their 2D and fitted view by view with the
-# focal known: a user's four following videos per walk.
+# the walker's root (the dolly of configs/gen/walks.yaml and of generate
+# --policy's rollouts; azimuths 30/120/210/300 deg, elevation 15 deg, the
+# middle of the generator's 0-30, 4.5 m, focal 1000 px), stripped to their
+# 2D and fitted view by view with the focal known: a user's four following
+# videos per walk. (Until 2026-12-04: elevation 10 deg and the 1-s path.)
 #
-#   [FIT_THREADS=N] scripts/make_walks.sh [OUT_DIR] [WALK...]   (default runs/walks,
-#   all nine; the fit's threads, default 2)
+#   [FIT_THREADS=N] [ELEVATION=deg] scripts/make_walks.sh [OUT_DIR] [WALK...]
+#   (default runs/walks, all nine; the fit's threads, default 2)
 #
 # Writes OUT_DIR/<walk>_truth.json (the measurement's side), <walk>_2d.json
 # (stripped) and <walk>.json (the fit's estimate: what training reads).
@@ -33,8 +35,8 @@ for walk in "${walks[@]}"; do
   motion="$long/humanoid3d_$walk.txt"
   [ -f "$motion" ] || { echo "make_walks: $motion not found" >&2; exit 1; }
   [ -f "$out/$walk.json" ] && { echo "kept $out/$walk.json"; continue; }
-  $bin clip from-motion "$motion" --views 4 --elevation 10 --distance 4.5 \
-    --focal 1000 --follow -o "$out/${walk}_truth.json" > /dev/null
+  $bin clip from-motion "$motion" --views 4 --elevation "${ELEVATION:-15}" \
+    --distance 4.5 --focal 1000 --follow --follow-smoothing 0 -o "$out/${walk}_truth.json" > /dev/null
   $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
     > /dev/null
   if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \

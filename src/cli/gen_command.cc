@@ -130,6 +130,9 @@ struct GenerateArgs {
   GenerationOptions generation;                  // --seed, sampling, placement
   std::vector<double> view = {30.0, 10.0, 4.5};  // azimuth, elevation, distance
   int motion = 0;  // data.motions index, for a prior conditioned on it
+  // With --policy and a prior conditioned on the motion: generation g
+  // draws motion g mod the config's motions instead of `motion`.
+  bool each_motion = false;
   double focal_px = 1000.0;
   // --policy: a tracker checkpoint driven along `generations` streams
   // (seeds seed, seed + 1, ...); --video: the first one drawn.
@@ -263,8 +266,10 @@ std::vector<TrackedSource> TrackedSources(const GenerateArgs& args) {
       GeneratedStreamOptions options;
       options.generation = args.generation;
       options.generation.seed = args.generation.seed + g;
-      options.generation.view = GenerationView(generator_config, azimuth_deg,
-                                               args.view[1], args.motion);
+      const int motion =
+          args.each_motion ? g % generator_config.prior_motions() : args.motion;
+      options.generation.view =
+          GenerationView(generator_config, azimuth_deg, args.view[1], motion);
       options.first_root_px = root_px;
       options.first_scale_px = scale_px;
       options.image_width_px = view_camera.intrinsics().width_px;
@@ -276,6 +281,11 @@ std::vector<TrackedSource> TrackedSources(const GenerateArgs& args) {
                     g + 1,
                     static_cast<unsigned long long>(options.generation.seed));
       source.label = label;
+      if (generator_config.prior.condition_on_motion)
+        source.label +=
+            ", " + std::filesystem::path(generator_config.data.motions[motion])
+                       .stem()
+                       .string();
       source.open = [run_dir = args.run_dir, options] {
         return std::make_unique<GeneratedStream>(run_dir, options);
       };
@@ -438,11 +448,12 @@ int RunTrackedGenerations(const GenerateArgs& args) {
 int RunGenerate(const GenerateArgs& args) {
   if (args.view.size() != 3)
     throw ConfigError("generate: --view takes azimuth,elevation,distance");
-  if (args.policy.empty() && (!args.video.empty() || args.generations != 1 ||
-                              !args.azimuths_deg.empty() || !args.real.empty()))
+  if (args.policy.empty() &&
+      (!args.video.empty() || args.generations != 1 ||
+       !args.azimuths_deg.empty() || !args.real.empty() || args.each_motion))
     throw ConfigError(
-        "generate: --video, --generations, --azimuths and --real need "
-        "--policy");
+        "generate: --video, --generations, --azimuths, --real and "
+        "--each-motion need --policy");
   if (args.start_at_s >= 0.0 && args.start != GeneratedStart::kFit)
     throw ConfigError(
         "generate: --start-at-s needs --start fit (the fit's pose there)");
@@ -679,6 +690,10 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "condition_on_motion): which of its config's data.motions "
                    "to generate (from 0)")
       ->capture_default_str();
+  generate->add_flag(
+      "--each-motion", generate_args->each_motion,
+      "With --policy and a prior conditioned on the motion: generation g "
+      "draws the config's motion g mod their number (instead of --motion)");
   generate->add_option("--focal", generate_args->focal_px,
                        "Camera focal length (px)");
   generate

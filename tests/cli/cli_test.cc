@@ -182,6 +182,52 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("need --policy"), std::string::npos)
       << result.output;
+  result = RunMimic2d("generate " + dir + "/gen --each-motion -o " + dir +
+                      "/x.json");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("need --policy"), std::string::npos)
+      << result.output;
+}
+
+// A prior conditioned on the motion: `generate --policy --each-motion`
+// spreads the tracked generations over the config's motions (generation g
+// draws motion g mod their number) and names each stream's motion.
+TEST(Cli, GenerateEachMotionSpreadsTrackedStreamsOverTheMotions) {
+  const std::string dir = testing::TempDir("cli_generate_each_motion");
+  const std::string config = WriteFile(
+      dir, "tiny.yaml",
+      "data:\n  motions: [" +
+          testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+          ", " +
+          testing::SourcePath("assets/motions/deepmimic/humanoid3d_run.txt") +
+          "]\n  loop_to_s: 4\n  num_azimuths: 2\n  elevations_deg: [10]\n"
+          "tokenizer:\n  num_codes: 16\n  code_size: 16\n  width: 32\n"
+          "  residual_depth: 1\n  window_frames: 16\n  batch_size: 4\n"
+          "  steps: 6\n"
+          "prior:\n  num_layers: 1\n  num_heads: 2\n  embedding: 16\n"
+          "  context_tokens: 8\n  batch_size: 4\n  steps: 4\n"
+          "  condition_on_view: true\n  condition_on_motion: true\n"
+          "run:\n  run_dir: " +
+          dir + "/gen\n  torch_threads: 1\n");
+  CommandResult result = RunMimic2d("gen train " + config);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::string policy =
+      testing::SourcePath("assets/policies/walk2d/checkpoint.pt");
+  result =
+      RunMimic2d("generate " + dir + "/gen --seconds 1 --policy " + policy +
+                 " --generations 3 --each-motion --start-fit-s 1 -o " + dir +
+                 "/generated.json");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("generation 1 (seed 1), humanoid3d_walk: "),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("generation 2 (seed 2), humanoid3d_run: "),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("generation 3 (seed 3), humanoid3d_walk: "),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("/3 ("), std::string::npos) << result.output;
 }
 
 // Each bad input: exit code 2, one line naming the file and the problem.
