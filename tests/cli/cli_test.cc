@@ -88,20 +88,30 @@ int CountOccurrences(const std::string& text, const std::string& needle) {
 // `generate --policy`: a tracker driven along generated 2D streamed frame
 // by frame (a tiny generator trained here, the committed walk2d tracker), a
 // line per stream, the totals and the first stream drawn.
-TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
-  const std::string dir = testing::TempDir("cli_generate");
-  const std::string config = WriteFile(
+// A generator config small enough to train in a second (dir/tiny.yaml,
+// run folder dir/gen): `motions` as a YAML list's items, `prior_extra`
+// more lines of the prior section.
+std::string WriteTinyGenConfig(const std::string& dir,
+                               const std::string& motions,
+                               const std::string& prior_extra) {
+  return WriteFile(
       dir, "tiny.yaml",
-      "data:\n  motions: [" +
-          testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+      "data:\n  motions: [" + motions +
           "]\n  loop_to_s: 4\n  num_azimuths: 2\n  elevations_deg: [10]\n"
           "tokenizer:\n  num_codes: 16\n  code_size: 16\n  width: 32\n"
           "  residual_depth: 1\n  window_frames: 16\n  batch_size: 4\n"
           "  steps: 6\n"
           "prior:\n  num_layers: 1\n  num_heads: 2\n  embedding: 16\n"
-          "  context_tokens: 8\n  batch_size: 4\n  steps: 4\n"
-          "run:\n  run_dir: " +
-          dir + "/gen\n  torch_threads: 1\n");
+          "  context_tokens: 8\n  batch_size: 4\n  steps: 4\n" +
+          prior_extra + "run:\n  run_dir: " + dir +
+          "/gen\n  torch_threads: 1\n");
+}
+
+TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
+  const std::string dir = testing::TempDir("cli_generate");
+  const std::string config = WriteTinyGenConfig(
+      dir, testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt"),
+      "");
   CommandResult result = RunMimic2d("gen train " + config);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const std::string policy =
@@ -194,21 +204,12 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
 // draws motion g mod their number) and names each stream's motion.
 TEST(Cli, GenerateEachMotionSpreadsTrackedStreamsOverTheMotions) {
   const std::string dir = testing::TempDir("cli_generate_each_motion");
-  const std::string config = WriteFile(
-      dir, "tiny.yaml",
-      "data:\n  motions: [" +
-          testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
+  const std::string config = WriteTinyGenConfig(
+      dir,
+      testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt") +
           ", " +
-          testing::SourcePath("assets/motions/deepmimic/humanoid3d_run.txt") +
-          "]\n  loop_to_s: 4\n  num_azimuths: 2\n  elevations_deg: [10]\n"
-          "tokenizer:\n  num_codes: 16\n  code_size: 16\n  width: 32\n"
-          "  residual_depth: 1\n  window_frames: 16\n  batch_size: 4\n"
-          "  steps: 6\n"
-          "prior:\n  num_layers: 1\n  num_heads: 2\n  embedding: 16\n"
-          "  context_tokens: 8\n  batch_size: 4\n  steps: 4\n"
-          "  condition_on_view: true\n  condition_on_motion: true\n"
-          "run:\n  run_dir: " +
-          dir + "/gen\n  torch_threads: 1\n");
+          testing::SourcePath("assets/motions/deepmimic/humanoid3d_run.txt"),
+      "  condition_on_view: true\n  condition_on_motion: true\n");
   CommandResult result = RunMimic2d("gen train " + config);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const std::string policy =
