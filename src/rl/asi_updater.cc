@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <algorithm>
+
 #include "env/reward.h"
 
 namespace m2d {
@@ -82,7 +84,7 @@ void AsiUpdater::Add(const Captures& captures) {
                                 captures.observations.end());
 }
 
-void AsiUpdater::Update(const Critic& critic, int iteration) {
+void AsiUpdater::Update(const Critic& critic, int64_t batch_samples) {
   torch::NoGradGuard no_grad;
   const std::vector<CapturedState>& states = captured_.states;
   if (!states.empty()) {
@@ -112,7 +114,23 @@ void AsiUpdater::Update(const Critic& critic, int iteration) {
       }
     }
   }
-  if (iteration % options_.rescore_every_iterations == 0) RescoreAll(critic);
+  // This iteration's share of the rescoring: a sweep every
+  // rescore_every_iterations, unless the cap per sample binds.
+  int64_t num_entries = 0;
+  for (int b = 0; b < initial_states_->num_buffers(); ++b) {
+    const StateBuffer& buffer = initial_states_->buffer(b);
+    for (int f = 0; f < buffer.num_frames(); ++f) num_entries += buffer.size(f);
+  }
+  int64_t share = (num_entries + options_.rescore_every_iterations - 1) /
+                  options_.rescore_every_iterations;
+  if (options_.rescore_max_entries_per_sample > 0) {
+    share = std::min<int64_t>(
+        share,
+        std::max<int64_t>(
+            1, static_cast<int64_t>(options_.rescore_max_entries_per_sample *
+                                    static_cast<double>(batch_samples))));
+  }
+  RescoreNextFrames(critic, share);
 }
 
 AsiUpdater::ObservedEntry& AsiUpdater::ObservedAt(int buffer, int frame,
@@ -129,33 +147,53 @@ AsiUpdater::ObservedEntry& AsiUpdater::ObservedAt(int buffer, int frame,
   return entries[entry];
 }
 
-void AsiUpdater::RescoreAll(const Critic& critic) {
-  // Outline: list every kept entry with the view it is seen from (drawn in
-  // order, so runs are reproducible for any thread count), observe in
+void AsiUpdater::RescoreNextFrames(const Critic& critic, int64_t max_entries) {
+  // Outline: from the cursor on, list whole frames' kept entries with the
+  // view each is seen from (drawn in order, so runs are reproducible for
+  // any thread count) until about max_entries are listed, observe in
   // parallel those not observed so from that view before, score them all
   // in one critic batch, write the scores back.
   struct Slot {
     int buffer, frame, entry, view;
   };
-  std::vector<Slot> slots;
+  const int num_buffers = initial_states_->num_buffers();
+  int64_t num_frames = 0;
+  for (int b = 0; b < num_buffers; ++b)
+    num_frames += initial_states_->buffer(b).num_frames();
+  if (num_frames == 0 || max_entries <= 0) return;
+  // The views each buffer serves: a state is scored as seen from one.
   const std::vector<TrackedView>& views = reference_->views();
-  for (int b = 0; b < initial_states_->num_buffers(); ++b) {
-    // A state is scored as seen from one of the views its buffer serves.
-    std::vector<int> buffer_views;
-    for (size_t v = 0; v < views.size(); ++v) {
-      if (initial_states_->BufferOf(static_cast<int>(v)) == b)
-        buffer_views.push_back(static_cast<int>(v));
-    }
+  std::vector<std::vector<int>> buffer_views(num_buffers);
+  for (size_t v = 0; v < views.size(); ++v)
+    buffer_views[initial_states_->BufferOf(static_cast<int>(v))].push_back(
+        static_cast<int>(v));
+  // The cursor's buffer and frame.
+  rescore_cursor_ %= num_frames;
+  int b = 0;
+  int64_t f = rescore_cursor_;
+  while (f >= initial_states_->buffer(b).num_frames())
+    f -= initial_states_->buffer(b++).num_frames();
+  std::vector<Slot> slots;
+  for (int64_t taken = 0;
+       taken < num_frames && static_cast<int64_t>(slots.size()) < max_entries;
+       ++taken) {
     const StateBuffer& buffer = initial_states_->buffer(b);
-    for (int f = 0; f < buffer.num_frames(); ++f) {
-      for (int i = 0; i < buffer.size(f); ++i) {
-        int view = buffer_views[std::uniform_int_distribution<size_t>(
-            0, buffer_views.size() - 1)(rng_)];
-        slots.push_back({b, f, i, view});
-      }
+    for (int i = 0; i < buffer.size(static_cast<int>(f)); ++i) {
+      const std::vector<int>& served = buffer_views[b];
+      int view = served[std::uniform_int_distribution<size_t>(
+          0, served.size() - 1)(rng_)];
+      slots.push_back({b, static_cast<int>(f), i, view});
+    }
+    rescore_cursor_ = (rescore_cursor_ + 1) % num_frames;
+    // The next frame, across buffers (and buffers without frames).
+    ++f;
+    while (f >= initial_states_->buffer(b).num_frames()) {
+      f = 0;
+      b = (b + 1) % num_buffers;
     }
   }
   if (slots.empty()) return;
+  num_entries_rescored_ += static_cast<int64_t>(slots.size());
 
   const int observation_size = scoring_envs_[0]->observation_size();
   std::vector<float> batch(slots.size() * observation_size);

@@ -1,8 +1,9 @@
 // rl: Adaptive State Initialization, the trainer's side. During collection
 // the running environments' visited states are captured; after the PPO
 // update the critic scores them and each replaces its frame's lowest-scoring
-// buffer entry if it scores higher; every few iterations all kept entries
-// are rescored, since the critic moves (docs/training.md, "ASI").
+// buffer entry if it scores higher; the kept entries are rescored in turn,
+// a share of the frames per iteration, since the critic moves
+// (docs/training.md, "ASI").
 #ifndef MIMIC2D_RL_ASI_UPDATER_H_
 #define MIMIC2D_RL_ASI_UPDATER_H_
 
@@ -55,14 +56,18 @@ class AsiUpdater {
   void CaptureRange(VecEnv& envs, int step, int begin, int end,
                     Captures* into) const;
   void Add(const Captures& captures);
-  // Scores the captures into the buffers; every rescore_every_iterations
-  // iterations also rescores every kept entry (each seen from a random view
-  // its buffer serves), observing them on `num_threads` OpenMP threads, and
+  // Scores the captures into the buffers, then rescores the kept entries of
+  // the next frames in turn (each entry seen from a random view its buffer
+  // serves): 1/rescore_every_iterations of all entries, at most
+  // rescore_max_entries_per_sample x `batch_samples` (the iteration's
+  // samples), observing them on `num_threads` OpenMP threads. Rescoring
   // replaces the entries beyond max_entry_error_px with their frame's
   // anchor (e.g. entries of a resumed run kept before the bound was set).
-  void Update(const Critic& critic, int iteration);
+  void Update(const Critic& critic, int64_t batch_samples);
   // Entries replaced by that bound so far (this process).
   int64_t num_entries_replaced() const { return num_entries_replaced_; }
+  // Entries rescored so far (this process).
+  int64_t num_entries_rescored() const { return num_entries_rescored_; }
 
  private:
   // A buffer entry's raw observation from `view`, kept with the part of the
@@ -96,7 +101,9 @@ class AsiUpdater {
   // The kept observation of entry `entry` of `frame` in `buffer`, grown on
   // first use.
   ObservedEntry& ObservedAt(int buffer, int frame, int entry);
-  void RescoreAll(const Critic& critic);
+  // Rescores the entries of the frames from the cursor on until about
+  // `max_entries` are taken (whole frames; every frame at most once).
+  void RescoreNextFrames(const Critic& critic, int64_t max_entries);
 
   AsiOptions options_;
   std::shared_ptr<const TrackingReference> reference_;
@@ -106,6 +113,9 @@ class AsiUpdater {
   std::mt19937_64 rng_;  // the view each entry is rescored from
   Captures captured_;
   int64_t num_entries_replaced_ = 0;
+  int64_t num_entries_rescored_ = 0;
+  // The next frame to rescore, counted over every buffer's frames in order.
+  int64_t rescore_cursor_ = 0;
   std::vector<std::vector<std::vector<ObservedEntry>>> observed_;  // [b][f][e]
 };
 

@@ -251,9 +251,17 @@ struct PpoOptions {
 struct AsiOptions {
   bool enabled = true;
   int capture_every_steps = 4;  // visited states offered to the buffers
-  // Every kept entry is rescored by the critic this often (the critic
-  // moves; an entry's stored score ages).
+  // Every kept entry is rescored by the critic about this often (the
+  // critic moves; an entry's stored score ages): each iteration rescores
+  // the next 1/rescore_every_iterations of the buffers' frames, in turn.
   int rescore_every_iterations = 10;
+  // ...but at most this many entries per sample of the iteration (0: no
+  // cap), so that rescoring costs at most about one more critic pass over
+  // the rollout: buffers of long references (the nine long walks: 36 views,
+  // 32k frames, 130k entries) otherwise cost 2/3 of training time
+  // (docs/training.md, item 10). A sweep then takes longer than
+  // rescore_every_iterations.
+  double rescore_max_entries_per_sample = 1.0;
   StateBufferOptions buffer{4, 2.0};  // per frame: 4 states, T = 2 (of V)
   // A state is kept for frame t only while its worst keypoint, projected by
   // the view it is seen from, lies within this of frame t's 2D (px); entries
@@ -278,8 +286,12 @@ struct AsiOptions {
       "visited states are offered to the buffers every this many steps");
     v("rescore_every_iterations", self.rescore_every_iterations,
       Range::AtLeast(1),
-      "every kept entry is rescored by the critic every this many "
-      "iterations");
+      "every kept entry is rescored by the critic about every this many "
+      "iterations (the next share of the buffers' frames each iteration)");
+    v("rescore_max_entries_per_sample", self.rescore_max_entries_per_sample,
+      Range::AtLeast(0),
+      "at most this many entries are rescored per sample of an iteration "
+      "(long references then sweep their buffers more slowly); 0: no cap");
     decltype(self.buffer)::VisitFields(self.buffer, v);
     v("max_entry_error_px", self.max_entry_error_px, Range::AtLeast(0),
       "states are kept only while their worst keypoint is within this of "

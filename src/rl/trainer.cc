@@ -506,7 +506,7 @@ TrainSummary Trainer::Run(
       const int64_t replaced_before = s.asi->num_entries_replaced();
       s.asi->Update(
           [&](const torch::Tensor& raw) { return s.CriticValue(raw); },
-          s.counters.iteration);
+          config.ppo.batch_size());
       const int64_t replaced = s.asi->num_entries_replaced() - replaced_before;
       if (replaced > 0) {
         // Said once (a resumed run's old entries); later ones at debug level.

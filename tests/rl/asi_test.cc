@@ -160,7 +160,7 @@ void RunCapturingIterations(const testing::WalkTask& task,
       envs.Step();
       asi.Capture(envs, t);
     }
-    asi.Update(critic, iteration);
+    asi.Update(critic, envs.num_envs() * 8);
   }
 }
 
@@ -175,6 +175,7 @@ TEST(Asi, RescoringScoresEveryEntrysOwnObservation) {
   AsiOptions options;
   options.capture_every_steps = 1;
   options.rescore_every_iterations = 2;
+  options.rescore_max_entries_per_sample = 0;  // half the frames each time
   AsiUpdater asi(task.character, task.reference, task.initial_states,
                  task.options, options, 3, 2);
   const AsiUpdater::Critic critic = [](const torch::Tensor& raw) {
@@ -207,6 +208,64 @@ TEST(Asi, RescoringScoresEveryEntrysOwnObservation) {
     }
   }
   EXPECT_GT(checked, 60);
+}
+
+// Rescoring takes the buffers' frames in turn: an Update rescores whole
+// frames until it holds rescore_max_entries_per_sample x its samples
+// entries, each entry once per sweep, so that long references (tens of
+// thousands of frames) cost a bounded share of each iteration and are
+// still all rescored within a number of Updates.
+TEST(Asi, RescoringTakesTheFramesInTurnWithinItsCap) {
+  M2D_REQUIRE_SHARED(walk_path, kWalk);
+  testing::WalkTask task = testing::MakeWalkTask(walk_path, 2.0);
+  AsiOptions options;
+  options.rescore_every_iterations = 1;  // a whole sweep, but for the cap
+  options.rescore_max_entries_per_sample = 0.5;
+  constexpr int64_t kSamples = 20;  // so 10 entries per Update
+  AsiUpdater asi(task.character, task.reference, task.initial_states,
+                 task.options, options, 3, 2);
+  InitialStates& states = *task.initial_states;
+  int64_t num_entries = 0;
+  int max_per_frame = 0;
+  for (int b = 0; b < states.num_buffers(); ++b) {
+    StateBuffer& buffer = states.buffer(b);
+    for (int f = 0; f < buffer.num_frames(); ++f) {
+      for (int e = 0; e < buffer.size(f); ++e) buffer.Rescore(f, e, -1.0);
+      num_entries += buffer.size(f);
+      max_per_frame = std::max(max_per_frame, buffer.size(f));
+    }
+  }
+  ASSERT_GT(num_entries, 40);
+  auto num_rescored_entries = [&] {
+    int64_t count = 0;
+    for (int b = 0; b < states.num_buffers(); ++b) {
+      const StateBuffer& buffer = states.buffer(b);
+      for (int f = 0; f < buffer.num_frames(); ++f)
+        for (int e = 0; e < buffer.size(f); ++e)
+          count += buffer.entry(f, e).score == 7.0;
+    }
+    return count;
+  };
+  const AsiUpdater::Critic critic = [](const torch::Tensor& raw) {
+    return torch::full({raw.size(0)}, 7.0, torch::kDouble);
+  };
+
+  int updates = 0;
+  while (asi.num_entries_rescored() < num_entries) {
+    const int64_t before = asi.num_entries_rescored();
+    asi.Update(critic, kSamples);
+    ++updates;
+    // Whole frames until 10 entries are held: 10 to 10 + a frame's less one.
+    EXPECT_GE(asi.num_entries_rescored() - before, 1);
+    EXPECT_LE(asi.num_entries_rescored() - before, 10 + max_per_frame - 1);
+    // Each entry once: none rescored twice before the sweep ends.
+    EXPECT_EQ(num_rescored_entries(),
+              std::min(asi.num_entries_rescored(), num_entries));
+    ASSERT_LE(updates, num_entries) << "the sweep does not end";
+  }
+  EXPECT_EQ(num_rescored_entries(), num_entries);
+  EXPECT_LE(updates, (num_entries + 9) / 10);
+  EXPECT_GE(updates, num_entries / (10 + max_per_frame - 1));
 }
 
 // The worst keypoint's distance (px) of `state` at `frame` from the 2D of
@@ -243,6 +302,7 @@ TEST(Asi, KeepsOnlyStatesNearTheirFrames2D) {
   AsiOptions options;
   options.capture_every_steps = 1;
   options.rescore_every_iterations = 2;
+  options.rescore_max_entries_per_sample = 0;
   options.max_entry_error_px = kBoundPx;
   AsiUpdater asi(task.character, task.reference, task.initial_states,
                  task.options, options, 3, 2);

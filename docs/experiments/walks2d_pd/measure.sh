@@ -1,0 +1,20 @@
+#!/bin/bash
+# Measures a walk-family tracker checkpoint two ways (docs/generation.md 4b,
+# "Servo or whole-PD torque limits for the walks"):
+#   1. the issue's protocol: the walk generator's streams (runs/gen_walks,
+#      each of its 9 motions once, azimuths 30 and 210 deg at elevation 15,
+#      60 s, starts and cameras from the fit of each stream's first 2 s);
+#   2. the training walks themselves (runs/walks, the fits' starts and
+#      cameras, 2 rollouts of 10 s per view), per walk.
+# No 3D truth is read by either.
+#   docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
+set -euo pipefail
+cd "$(dirname "$0")/../../.."
+checkpoint=$1 out=$2
+build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
+  --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
+  -o "${out}_generated.json" > "${out}_generated.log" 2>&1
+grep -E "generation|^Succ" "${out}_generated.log"
+build/mimic2d eval "$checkpoint" --episodes 2 --episode-s 10 \
+  -o "${out}_eval.json" > "${out}_eval.log" 2>&1
+tail -n 45 "${out}_eval.log"
