@@ -174,8 +174,8 @@ void AsiUpdater::RescoreNextFrames(const Critic& critic, int64_t max_entries) {
   while (f >= initial_states_->buffer(b).num_frames())
     f -= initial_states_->buffer(b++).num_frames();
   std::vector<Slot> slots;
-  for (int64_t taken = 0;
-       taken < num_frames && static_cast<int64_t>(slots.size()) < max_entries;
+  int64_t taken = 0;  // frames
+  for (; taken < num_frames && static_cast<int64_t>(slots.size()) < max_entries;
        ++taken) {
     const StateBuffer& buffer = initial_states_->buffer(b);
     for (int i = 0; i < buffer.size(static_cast<int>(f)); ++i) {
@@ -184,7 +184,6 @@ void AsiUpdater::RescoreNextFrames(const Critic& critic, int64_t max_entries) {
           0, served.size() - 1)(rng_)];
       slots.push_back({b, static_cast<int>(f), i, view});
     }
-    rescore_cursor_ = (rescore_cursor_ + 1) % num_frames;
     // The next frame, across buffers (and buffers without frames).
     ++f;
     while (f >= initial_states_->buffer(b).num_frames()) {
@@ -192,6 +191,7 @@ void AsiUpdater::RescoreNextFrames(const Critic& critic, int64_t max_entries) {
       b = (b + 1) % num_buffers;
     }
   }
+  rescore_cursor_ = (rescore_cursor_ + taken) % num_frames;
   if (slots.empty()) return;
   num_entries_rescored_ += static_cast<int64_t>(slots.size());
 

@@ -253,7 +253,8 @@ struct AsiOptions {
   int capture_every_steps = 4;  // visited states offered to the buffers
   // Every kept entry is rescored by the critic about this often (the
   // critic moves; an entry's stored score ages): each iteration rescores
-  // the next 1/rescore_every_iterations of the buffers' frames, in turn.
+  // the next whole frames, in turn, holding 1/rescore_every_iterations of
+  // the kept entries.
   int rescore_every_iterations = 10;
   // ...but at most this many entries per sample of the iteration (0: no
   // cap), so that rescoring costs at most about one more critic pass over
