@@ -6,7 +6,10 @@
 # --policy's rollouts; azimuths 30/120/210/300 deg, elevation 15 deg, the
 # middle of the generator's 0-30, 4.5 m, focal 1000 px), stripped to their
 # 2D and fitted view by view with the focal known: a user's four following
-# videos per walk. (Until 2026-12-04: elevation 10 deg and the 1-s path.)
+# videos per walk, fitted with configs/fit/root_dolly.yaml (the camera's
+# centre sways with every step; until 2026-12-05 the default camera
+# smoothness tilted 28 of the 36 views' worlds 13-35 deg). (Until
+# 2026-12-04: elevation 10 deg and the 1-s path.)
 #
 #   [FIT_THREADS=N] [ELEVATION=deg] scripts/make_walks.sh [OUT_DIR] [WALK...]
 #   (default runs/walks, all nine; the fit's threads, default 2)
@@ -40,7 +43,7 @@ for walk in "${walks[@]}"; do
   $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
     > /dev/null
   if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \
-    --threads "${FIT_THREADS:-2}" --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
+    --config configs/fit/root_dolly.yaml --threads "${FIT_THREADS:-2}" --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
   then
     echo "fitted $walk: $(grep -c 'all frames converged' "$out/${walk}_fit.log") of 4 views converged on every frame"
   else

@@ -13,6 +13,7 @@
 #include "cli/motion_source.h"
 #include "common/error.h"
 #include "common/file_io.h"
+#include "eval/fit_accuracy.h"
 #include "eval/motion_feasibility.h"
 #include "motion/bundle.h"
 #include "motion/clip_io.h"
@@ -181,11 +182,51 @@ int RunResample(const ResampleArgs& args) {
   return 0;
 }
 
-int RunInfo(const std::string& path) {
+struct InfoArgs {
+  std::string path;
+  // A bundle holding the truth of `path`'s fitted estimate: each view's fit
+  // is measured against it (focal, pitch, roll, MPJPE, PA-MPJPE), as `fit
+  // --truth` does after fitting, without fitting again.
+  std::string truth;
+  std::string character = "characters/humanoid.yaml";
+};
+
+// Each view's estimate in `bundle` against `truth` (ReadMatchingTruth's),
+// one line per view and their mean.
+void PrintFitAccuracy(const ReferenceBundle& bundle, const InfoArgs& args) {
+  if (!bundle.estimate) {
+    throw InputError(args.path,
+                     "--truth: the bundle holds no estimate to measure (fit "
+                     "it first: mimic2d fit)");
+  }
+  const ReferenceBundle truth =
+      ReadMatchingTruth(args.truth, bundle, args.path);
+  auto character = LoadCharacterForSimulation(AssetArgumentPath(args.character),
+                                              "flat", SimulationOptions());
+  std::vector<FitAccuracy> accuracies;
+  for (size_t view = 0; view < bundle.views.size(); ++view) {
+    accuracies.push_back(MeasureFitAccuracy((*bundle.estimate)[view],
+                                            truth.views[view].cameras,
+                                            *truth.ground_truth, *character));
+    std::printf("view %zu/%zu (%s), against the truth: %s\n", view + 1,
+                bundle.views.size(), bundle.views[view].name.c_str(),
+                accuracies.back().BriefReport().c_str());
+  }
+  std::printf("mean over the views, against the truth: %s\n",
+              MeanFitAccuracy(accuracies).BriefReport().c_str());
+}
+
+int RunInfo(const InfoArgs& args) {
+  const std::string& path = args.path;
   nlohmann::json json = ReadJsonFile(path);
   if (json.is_object() && json.value("format", "") == kBundleFormat) {
-    PrintBundleSummary(ReadBundle(path), path);
+    const ReferenceBundle bundle = ReadBundle(path);
+    PrintBundleSummary(bundle, path);
+    if (!args.truth.empty()) PrintFitAccuracy(bundle, args);
     return 0;
+  }
+  if (!args.truth.empty()) {
+    throw InputError(path, "--truth: a clip holds no fit to measure");
   }
   Clip2D clip = ReadClip(path);
   long present = 0;
@@ -493,11 +534,21 @@ void AddClipCommand(CLI::App& app, CommandRun* run) {
     *run = [feasibility] { return RunFeasibility(*feasibility); };
   });
 
-  auto info_path = std::make_shared<std::string>();
+  auto info_args = std::make_shared<InfoArgs>();
   CLI::App* info = clip->add_subcommand("info", "Summarize a clip or a bundle");
-  info->add_option("file", *info_path, "Clip or bundle JSON")->required();
+  info->add_option("file", info_args->path, "Clip or bundle JSON")->required();
+  info->add_option("--truth", info_args->truth,
+                   "bundle holding the 3D truth and true cameras of the "
+                   "file's fitted estimate (e.g. the original of the bundle "
+                   "that was stripped and fitted): each view's fit is "
+                   "measured against it (focal, pitch, roll, MPJPE, "
+                   "PA-MPJPE) without fitting again");
+  info->add_option("--character", info_args->character,
+                   "character config the fit posed (relative to assets/ "
+                   "unless absolute); with --truth")
+      ->capture_default_str();
   info->callback(
-      [run, info_path] { *run = [info_path] { return RunInfo(*info_path); }; });
+      [run, info_args] { *run = [info_args] { return RunInfo(*info_args); }; });
 }
 
 }  // namespace m2d::cli

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/motion_source.h"
 #include "common/error.h"
 #include "eval/fit_accuracy.h"
 #include "fit/fit.h"
@@ -61,19 +62,7 @@ int RunFit(FitArgs& args) {
   const ReferenceBundle bundle = ReadBundleOrClip(args.input);
   std::optional<ReferenceBundle> truth;
   if (!args.truth.empty()) {
-    truth = ReadBundle(args.truth);
-    if (!truth->ground_truth) {
-      throw InputError(args.truth, "--truth: the bundle holds no 3D truth");
-    }
-    if (truth->views.size() != bundle.views.size() ||
-        truth->num_frames() != bundle.num_frames()) {
-      throw InputError(args.truth,
-                       "--truth: " + std::to_string(truth->views.size()) +
-                           " views of " + std::to_string(truth->num_frames()) +
-                           " frames, but " + args.input + " has " +
-                           std::to_string(bundle.views.size()) + " of " +
-                           std::to_string(bundle.num_frames()));
-    }
+    truth = ReadMatchingTruth(args.truth, bundle, args.input);
   }
   const std::string character_path = AssetArgumentPath(args.character);
   auto character =

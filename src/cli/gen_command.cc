@@ -20,6 +20,7 @@
 #include "env/reference.h"
 #include "env/reference_stream.h"
 #include "fit/fit.h"
+#include "fit/fit_config.h"
 #include "gen/gen_config.h"
 #include "gen/gen_trainer.h"
 #include "gen/generated_stream.h"
@@ -143,6 +144,9 @@ struct GenerateArgs {
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
+  // With kFit: FitOptions YAML for that fit ("": the defaults); the camera
+  // is moving and the focal --focal's whatever it says.
+  std::string fit_config;
   // With kFit: the rollout starts this far into the stream (s), from the
   // fit's pose there; the frames before it are not tracked. Negative: the
   // middle of the fitted seconds (StartAtS).
@@ -315,7 +319,9 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   const int root = character->root_qpos_address();
   const int root_dof = character->root_dof_address();  // world-frame velocity
   const std::vector<TrackedSource> sources = TrackedSources(args);
-  FitOptions fit_options;  // the stream's first seconds as a user's clip
+  // The stream's first seconds as a user's clip.
+  FitOptions fit_options =
+      args.fit_config.empty() ? FitOptions() : ReadFitOptions(args.fit_config);
   fit_options.camera_motion = CameraMotion::kMoving;
   fit_options.fixed_focal_px = args.focal_px;
   fit_options.num_threads = 1;
@@ -325,9 +331,11 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   if (args.start == GeneratedStart::kFit) {
     std::printf(
         "starts and cameras from the fit of each stream's first %.1f s "
-        "(moving camera, focal %.0f px; no 3D), at %.1f s into it, the camera "
-        "dollying with the character\n",
-        args.start_fit_s, args.focal_px, StartAtS(args));
+        "(moving camera, focal %.0f px, settings %s; no 3D), at %.1f s into "
+        "it, the camera dollying with the character\n",
+        args.start_fit_s, args.focal_px,
+        args.fit_config.empty() ? "default" : args.fit_config.c_str(),
+        StartAtS(args));
   } else {
     std::printf(
         "starts from the default pose placed under the first generated frame "
@@ -734,6 +742,13 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->add_option("--start-fit-s", generate_args->start_fit_s,
                    "With --start fit: seconds of each stream fitted")
       ->check(CLI::Range(0.5, 60.0));
+  generate
+      ->add_option("--fit-config", generate_args->fit_config,
+                   "With --start fit: FitOptions YAML for the fit of each "
+                   "stream's first seconds (docs/fit.md, \"Settings\"), e.g. "
+                   "the training fits' configs/fit/root_dolly.yaml; the "
+                   "camera is moving and the focal --focal's")
+      ->check(CLI::ExistingFile);
   generate
       ->add_option("--start-at-s", generate_args->start_at_s,
                    "With --start fit: start this far into the stream, from "

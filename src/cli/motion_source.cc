@@ -218,4 +218,23 @@ void PrintBundleSummary(const ReferenceBundle& bundle,
   }
 }
 
+ReferenceBundle ReadMatchingTruth(const std::string& truth_path,
+                                  const ReferenceBundle& bundle,
+                                  const std::string& bundle_path) {
+  ReferenceBundle truth = ReadBundle(truth_path);
+  if (!truth.ground_truth) {
+    throw InputError(truth_path, "--truth: the bundle holds no 3D truth");
+  }
+  if (truth.views.size() != bundle.views.size() ||
+      truth.num_frames() != bundle.num_frames()) {
+    throw InputError(truth_path,
+                     "--truth: " + std::to_string(truth.views.size()) +
+                         " views of " + std::to_string(truth.num_frames()) +
+                         " frames, but " + bundle_path + " has " +
+                         std::to_string(bundle.views.size()) + " of " +
+                         std::to_string(bundle.num_frames()));
+  }
+  return truth;
+}
+
 }  // namespace m2d::cli

@@ -30,6 +30,13 @@ void AddBundleOptions(CLI::App& command, BundleFromMotionOptions* options,
                       bool* follow);
 LoadedMotion LoadMotionSource(const MotionSourceArgs& args);
 void PrintBundleSummary(const ReferenceBundle& bundle, const std::string& path);
+// The bundle at `truth_path` holding `bundle`'s 3D truth and true cameras
+// (e.g. the original of a stripped bundle), for measuring a fit against it.
+// InputError naming the file when it has no truth or its views or frames
+// differ from `bundle`'s (read from `bundle_path`).
+ReferenceBundle ReadMatchingTruth(const std::string& truth_path,
+                                  const ReferenceBundle& bundle,
+                                  const std::string& bundle_path);
 
 }  // namespace m2d::cli
 

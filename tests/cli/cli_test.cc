@@ -159,8 +159,16 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   ASSERT_EQ(result.exit_code, 0) << result.output;
   result = RunMimic2d("generate " + dir + "/gen --seconds 3 --policy " +
                       policy + " --real " + dir +
-                      "/real.json --start-at-s 0.5 -o " + dir + "/unused.json");
+                      "/real.json --start-at-s 0.5 --fit-config " +
+                      testing::SourcePath("configs/fit/root_dolly.yaml") +
+                      " -o " + dir + "/unused.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
+  // The start's fit with the settings for a camera on the root.
+  EXPECT_NE(
+      result.output.find("settings " +
+                         testing::SourcePath("configs/fit/root_dolly.yaml")),
+      std::string::npos)
+      << result.output;
   EXPECT_EQ(CountOccurrences(result.output, "tracked to the end"), 2)
       << result.output;
   EXPECT_NE(result.output.find("Succ 2/2"), std::string::npos) << result.output;
@@ -796,6 +804,25 @@ TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
   ASSERT_NE(pa, std::string::npos);
   EXPECT_LT(std::stod(result.output.substr(pa + 9)), 60.0) << result.output;
 
+  // `clip info --truth` measures the written fit again, without fitting:
+  // the same figures as the fit printed.
+  const CommandResult info =
+      RunMimic2d("clip info " + dir + "/fitted.json --truth " + truth);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const size_t info_mean = info.output.find("mean over the views");
+  ASSERT_NE(info_mean, std::string::npos) << info.output;
+  const auto pitch_and_pa = [](const std::string& text, size_t from) {
+    const size_t pitch = text.find(", pitch ", from);
+    const size_t mpjpe = text.find(", MPJPE ", from);
+    return text.substr(pitch, mpjpe - pitch) +
+           text.substr(text.find("PA-MPJPE ", from), 14);
+  };
+  EXPECT_EQ(pitch_and_pa(info.output, info_mean),
+            pitch_and_pa(result.output, mean))
+      << info.output << result.output;
+  ExpectInputError("clip info " + stripped + " --truth " + truth, stripped,
+                   "no estimate to measure");
+
   ASSERT_EQ(RunMimic2d("clip from-motion " + walk + " --views 1 -o " + dir +
                        "/one_view.json")
                 .exit_code,
@@ -806,6 +833,9 @@ TEST(Cli, FitMeasuresEachViewAgainstAGivenTruth) {
   ExpectInputError("fit " + stripped + " --quiet --truth " + stripped + " -o " +
                        dir + "/never.json",
                    stripped, "holds no 3D truth");
+  ExpectInputError(
+      "clip info " + dir + "/fitted.json --truth " + dir + "/one_view.json",
+      dir + "/one_view.json", "--truth: 1 views");
   // A rig is two or more views of one take.
   ExpectInputError(
       "fit " + dir + "/one_view.json --rig --quiet -o " + dir + "/never.json",

@@ -7,12 +7,17 @@
 #   2. the training walks themselves (runs/walks, the fits' starts and
 #      cameras, 2 rollouts of 10 s per view), per walk.
 # No 3D truth is read by either.
-#   docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
+#   [FIT_CONFIG=configs/fit/root_dolly.yaml] \
+#     docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
+# FIT_CONFIG: the FitOptions of the streams' start fits (default: the
+# defaults, as every figure before 2026-12-05 was measured).
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 checkpoint=$1 out=$2
+fit_config=()
+[ -n "${FIT_CONFIG:-}" ] && fit_config=(--fit-config "$FIT_CONFIG")
 build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
-  --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
+  "${fit_config[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
   -o "${out}_generated.json" > "${out}_generated.log" 2>&1
 grep -E "generation|^Succ" "${out}_generated.log"
 build/mimic2d eval "$checkpoint" --episodes 2 --episode-s 10 \
