@@ -43,7 +43,8 @@ for walk in "${walks[@]}"; do
   $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
     > /dev/null
   if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \
-    --config configs/fit/root_dolly.yaml --threads "${FIT_THREADS:-2}" --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
+    --config configs/fit/root_dolly.yaml --threads "${FIT_THREADS:-2}" \
+    --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
   then
     echo "fitted $walk: $(grep -c 'all frames converged' "$out/${walk}_fit.log") of 4 views converged on every frame"
   else

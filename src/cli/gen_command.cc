@@ -144,8 +144,8 @@ struct GenerateArgs {
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
-  // With kFit: FitOptions YAML for that fit ("": the defaults); the camera
-  // is moving and the focal --focal's whatever it says.
+  // With kFit: FitOptions YAML for that fit ("": the defaults); whatever
+  // the file says, the camera is moving and the focal is --focal's.
   std::string fit_config;
   // With kFit: the rollout starts this far into the stream (s), from the
   // fit's pose there; the frames before it are not tracked. Negative: the
