@@ -8,7 +8,7 @@
 # 2D and fitted view by view with the focal known: a user's four following
 # videos per walk, fitted with configs/fit/root_dolly.yaml (the camera's
 # centre sways with every step; until 2026-12-05 the default camera
-# smoothness tilted 28 of the 36 views' worlds 13-35 deg). (Until
+# smoothness tilted 25 of the 36 views' worlds 14-35 deg). (Until
 # 2026-12-04: elevation 10 deg and the 1-s path.)
 #
 #   [FIT_THREADS=N] [ELEVATION=deg] scripts/make_walks.sh [OUT_DIR] [WALK...]
