@@ -16,6 +16,11 @@ double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
   return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
 }
 
+double FailureHazard(const ViewFailureRecord& record) {
+  if (record.steps <= 0.0) return -1.0;
+  return record.failures / record.steps;
+}
+
 namespace {
 
 // Each view's FullRolloutFailure (negative: no episodes yet), and how many
@@ -27,11 +32,15 @@ struct FailureChances {
 };
 
 FailureChances ChancesOf(const std::vector<ViewFailureRecord>& records,
-                         const std::vector<int>& num_frames) {
+                         const std::vector<int>& num_frames,
+                         HardViewMeasure measure) {
   FailureChances chances;
   double known_sum = 0.0;
   for (size_t v = 0; v < records.size(); ++v) {
-    chances.per_view.push_back(FullRolloutFailure(records[v], num_frames[v]));
+    chances.per_view.push_back(
+        measure == HardViewMeasure::kHazard
+            ? FailureHazard(records[v])
+            : FullRolloutFailure(records[v], num_frames[v]));
     if (chances.per_view.back() < 0.0) continue;
     known_sum += chances.per_view.back();
     ++chances.known;
@@ -44,12 +53,12 @@ FailureChances ChancesOf(const std::vector<ViewFailureRecord>& records,
 
 std::vector<double> HardViewWeights(
     const std::vector<ViewFailureRecord>& records,
-    const std::vector<int>& num_frames, double share) {
-  // Outline: each view's failure chance (unknown ones at the known mean),
-  // then the uniform part plus the share in proportion to them.
+    const std::vector<int>& num_frames, double share, HardViewMeasure measure) {
+  // Outline: each view's measure (unknown ones at the known mean), then the
+  // uniform part plus the share in proportion to them.
   const size_t num_views = records.size();
   std::vector<double> weights(num_views, 1.0 / num_views);
-  FailureChances chances = ChancesOf(records, num_frames);
+  FailureChances chances = ChancesOf(records, num_frames, measure);
   if (chances.known == 0 || chances.known_mean <= 0.0) return weights;
   for (double& f : chances.per_view) {
     if (f < 0.0) f = chances.known_mean;
@@ -64,8 +73,9 @@ std::vector<double> HardViewWeights(
 }
 
 HardViewSampler::HardViewSampler(const TrackingReference& reference,
-                                 double share, double half_life_samples)
-    : share_(share), half_life_samples_(half_life_samples) {
+                                 double share, double half_life_samples,
+                                 HardViewMeasure measure)
+    : share_(share), half_life_samples_(half_life_samples), measure_(measure) {
   if (!(share >= 0.0 && share <= 1.0) || !(half_life_samples > 0.0)) {
     throw ConfigError(fmt::format(
         "hard views: share {} (0..1) and half life {} samples (> 0)", share,
@@ -85,20 +95,23 @@ void HardViewSampler::Record(const std::vector<FinishedEpisode>& finished,
   for (ViewFailureRecord& record : records_) {
     record.steps *= keep;
     record.failures *= keep;
+    record.episodes *= keep;
   }
   for (const FinishedEpisode& episode : finished) {
     ViewFailureRecord& record = records_.at(episode.stats.view_index);
     record.steps += episode.stats.steps;
     record.failures += episode.stats.failed ? 1.0 : 0.0;
+    record.episodes += 1.0;
   }
 }
 
 std::vector<double> HardViewSampler::Weights() const {
-  return HardViewWeights(records_, num_frames_, share_);
+  return HardViewWeights(records_, num_frames_, share_, measure_);
 }
 
 std::string HardViewSampler::Report(int count) const {
-  const FailureChances chances = ChancesOf(records_, num_frames_);
+  const FailureChances chances =
+      ChancesOf(records_, num_frames_, HardViewMeasure::kFullRollout);
   if (chances.known == 0) return "no episodes yet";
   const std::vector<double>& failure = chances.per_view;
   const std::vector<double> weights = Weights();
@@ -112,8 +125,12 @@ std::string HardViewSampler::Report(int count) const {
   for (int i = 0; i < std::min<int>(count, order.size()); ++i) {
     const int v = order[i];
     if (failure[v] < 0.0) break;
-    report += fmt::format("{} {} {:.2f} (w {:.3f})", i == 0 ? "" : ",",
-                          view_names_[v], failure[v], weights[v]);
+    const ViewFailureRecord& record = records_[v];
+    const double steps_per_episode =
+        record.episodes > 0.0 ? record.steps / record.episodes : 0.0;
+    report +=
+        fmt::format("{} {} {:.2f} ({:.0f} steps, w {:.3f})", i == 0 ? "" : ",",
+                    view_names_[v], failure[v], steps_per_episode, weights[v]);
   }
   return report;
 }

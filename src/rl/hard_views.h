@@ -12,14 +12,17 @@
 
 #include "env/reference.h"
 #include "env/vec_env.h"
+#include "rl/train_config.h"
 
 namespace m2d {
 
-// A view's training experience, decayed with age: steps simulated and
-// episodes ended by early exit (or divergence) over them.
+// A view's training experience, decayed with age: steps simulated,
+// episodes ended by early exit (or divergence) over them, and episodes
+// ended in all.
 struct ViewFailureRecord {
   double steps = 0.0;
   double failures = 0.0;
+  double episodes = 0.0;
 };
 
 // Probability that a rollout of `num_frames` frames fails when early exits
@@ -28,19 +31,26 @@ struct ViewFailureRecord {
 // steps (unknown).
 double FullRolloutFailure(const ViewFailureRecord& record, int num_frames);
 
+// Early exits per step simulated (the constant hazard h); negative when the
+// record holds no steps (unknown).
+double FailureHazard(const ViewFailureRecord& record);
+
 // Start weights per view, summing to 1: a `share` in proportion to each
-// view's FullRolloutFailure (an unknown view counts as the known views'
-// mean), the rest uniform. Uniform when no view is known to fail.
+// view's `measure` (FullRolloutFailure or FailureHazard; an unknown view
+// counts as the known views' mean), the rest uniform. Uniform when no view
+// is known to fail.
 std::vector<double> HardViewWeights(
     const std::vector<ViewFailureRecord>& records,
-    const std::vector<int>& num_frames, double share);
+    const std::vector<int>& num_frames, double share,
+    HardViewMeasure measure = HardViewMeasure::kFullRollout);
 
 class HardViewSampler {
  public:
-  // `share`, `half_life_samples`: AsiOptions' hard_view_share and
-  // hard_view_half_life_samples.
+  // `share`, `half_life_samples`, `measure`: AsiOptions' hard_view_share,
+  // hard_view_half_life_samples and hard_view_measure.
   HardViewSampler(const TrackingReference& reference, double share,
-                  double half_life_samples);
+                  double half_life_samples,
+                  HardViewMeasure measure = HardViewMeasure::kFullRollout);
 
   // Ages the records by a batch of `batch_samples` and adds the episodes
   // that ended in it.
@@ -48,8 +58,9 @@ class HardViewSampler {
               int64_t batch_samples);
   std::vector<double> Weights() const;
   // A brief report: the mean failure chance over the views with episodes,
-  // then the `count` views most likely to fail, with that chance and their
-  // start weight ("...; hardest: kick view 2 0.93 (w 0.061), ...").
+  // then the `count` views most likely to fail, with that chance, their
+  // mean episode length (steps) and their start weight ("...; hardest:
+  // kick view 2 0.93 (12 steps, w 0.061), ...").
   std::string Report(int count) const;
 
  private:
@@ -57,6 +68,7 @@ class HardViewSampler {
   std::vector<int> num_frames_;
   double share_;
   double half_life_samples_;
+  HardViewMeasure measure_;
   std::vector<ViewFailureRecord> records_;
 };
 

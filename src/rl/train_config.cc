@@ -93,6 +93,15 @@ bool ParseSetting(const std::string& text, CollectionMode* mode) {
       text, {CollectionMode::kBatched, CollectionMode::kPerThread}, mode);
 }
 
+const char* SettingName(HardViewMeasure measure) {
+  return measure == HardViewMeasure::kHazard ? "hazard" : "full_rollout";
+}
+
+bool ParseSetting(const std::string& text, HardViewMeasure* measure) {
+  return ParseSettingByName(
+      text, {HardViewMeasure::kFullRollout, HardViewMeasure::kHazard}, measure);
+}
+
 void ModelOptions::Validate() const {
   CheckRanges(*this, "model");
   // Far above useful depths: a typo (or a damaged checkpoint's config) is

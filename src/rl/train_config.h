@@ -144,6 +144,23 @@ inline std::string SettingChoices(CollectionMode) {
   return "batched, per_thread";
 }
 
+// What hard-view sampling (rl/hard_views.h) starts views in proportion to.
+enum class HardViewMeasure {
+  // The chance that a rollout of the whole view fails: favours the failing
+  // views, but while most views fail every view of a long clip nears 1.
+  kFullRollout,
+  // The early exits per step simulated (the hazard): starts in proportion
+  // to it give every failing view about the same samples, however soon its
+  // episodes end (a clip lost in 11 frames otherwise gets 1/20 of the
+  // samples of one held for 200).
+  kHazard,
+};
+const char* SettingName(HardViewMeasure measure);
+bool ParseSetting(const std::string& text, HardViewMeasure* measure);
+inline std::string SettingChoices(HardViewMeasure) {
+  return "full_rollout, hazard";
+}
+
 // PPO (CleanRL-style "agent" config). Every field is documented in
 // configs/README.md with the reasoning behind its default.
 struct PpoOptions {
@@ -277,6 +294,8 @@ struct AsiOptions {
   double hard_view_share = 0.0;
   // The failure records forget with this half life (samples of training).
   double hard_view_half_life_samples = 2e6;
+  // What the share's starts are in proportion to.
+  HardViewMeasure hard_view_measure = HardViewMeasure::kFullRollout;
 
   // Every setting (common/settings.h): the config's `asi` section.
   template <typename Self, typename Visitor>
@@ -304,6 +323,10 @@ struct AsiOptions {
     v("hard_view_half_life_samples", self.hard_view_half_life_samples,
       Range::Above(0),
       "half life (samples) of the failure records hard-view sampling reads");
+    v("hard_view_measure", self.hard_view_measure, Range::Any(),
+      "what hard-view starts are in proportion to: full_rollout (a view's "
+      "chance of failing a whole rollout) or hazard (its early exits per "
+      "step: every failing view gets about the same samples)");
   }
   void Validate() const;
 };

@@ -217,7 +217,7 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     // starts stay uniform until episodes have ended.
     s.hard_views = std::make_unique<HardViewSampler>(
         *s.reference, config.asi.hard_view_share,
-        config.asi.hard_view_half_life_samples);
+        config.asi.hard_view_half_life_samples, config.asi.hard_view_measure);
   }
   s.state_template = s.envs->env(0).simulation().Save();
   s.model = ActorCritic(s.envs->layout(), config.model, s.envs->action_size());

@@ -52,6 +52,28 @@ TEST(HardViews, WeightsAreUniformPlusAShareInProportionToFailure) {
   }
 }
 
+TEST(HardViews, HazardWeightsGiveFailingViewsEqualSamples) {
+  EXPECT_LT(FailureHazard({}), 0.0);  // no steps: unknown
+  EXPECT_DOUBLE_EQ(FailureHazard({1000.0, 10.0}), 0.01);
+  // Views lost after 10 and after 200 steps, one never lost, one unknown
+  // (at the known mean): over long views both failing ones are near 1 as
+  // full-rollout chances, while by hazard the quick failure gets 20x the
+  // starts, so both get the same samples (starts x steps per episode).
+  const std::vector<int> frames = {2000, 2000, 2000, 2000};
+  const std::vector<ViewFailureRecord> records = {
+      {1000, 100}, {1000, 5}, {1000, 0}, {0, 0}};
+  const std::vector<double> chance =
+      HardViewWeights(records, frames, 1.0, HardViewMeasure::kFullRollout);
+  EXPECT_NEAR(chance[0] / chance[1], 1.0, 1e-3);
+  const std::vector<double> hazard =
+      HardViewWeights(records, frames, 1.0, HardViewMeasure::kHazard);
+  EXPECT_NEAR(std::accumulate(hazard.begin(), hazard.end(), 0.0), 1.0, 1e-12);
+  EXPECT_NEAR(hazard[0] * 10.0, hazard[1] * 200.0, 1e-12);
+  EXPECT_DOUBLE_EQ(hazard[2], 0.0);
+  const double known_mean = (0.1 + 0.005 + 0.0) / 3.0;
+  EXPECT_NEAR(hazard[3] / hazard[0], known_mean / 0.1, 1e-12);
+}
+
 TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
   TrackingTask task = testing::MakeGlidingTask(/*num_views=*/2);
   HardViewSampler sampler(*task.reference, /*share=*/1.0,
@@ -74,7 +96,7 @@ TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
   EXPECT_NE(report.find("mean failure chance 0.50 over 2 of 2 views"),
             std::string::npos)
       << report;
-  EXPECT_NE(report.find("hardest: gliding view 0 1.00 (w 1.000)"),
+  EXPECT_NE(report.find("hardest: gliding view 0 1.00 (5 steps, w 1.000)"),
             std::string::npos)
       << report;
   // Later the views swap; after many half lives the old records are gone.
