@@ -10,15 +10,15 @@
 
 namespace m2d {
 
-double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
-  if (record.steps <= 0.0) return -1.0;
-  const double hazard_per_step = record.failures / record.steps;
-  return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
-}
-
 double FailureHazard(const ViewFailureRecord& record) {
   if (record.steps <= 0.0) return -1.0;
   return record.failures / record.steps;
+}
+
+double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
+  const double hazard_per_step = FailureHazard(record);
+  if (hazard_per_step < 0.0) return -1.0;
+  return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
 }
 
 namespace {
@@ -117,20 +117,26 @@ std::string HardViewSampler::Report(int count) const {
   const std::vector<double> weights = Weights();
   std::vector<int> order(records_.size());
   std::iota(order.begin(), order.end(), 0);
+  // Hardest first by start weight (the configured measure's order; under
+  // kHazard the chances of long views all round to 1), then by chance.
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return failure[a] > failure[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return weights[a] > weights[b]; });
   std::string report =
       fmt::format("mean failure chance {:.2f} over {} of {} views; hardest:",
                   chances.known_mean, chances.known, failure.size());
-  for (int i = 0; i < std::min<int>(count, order.size()); ++i) {
-    const int v = order[i];
-    if (failure[v] < 0.0) break;
+  int listed = 0;
+  for (int v : order) {
+    if (listed == count) break;
+    if (failure[v] < 0.0) continue;  // no episodes yet
     const ViewFailureRecord& record = records_[v];
     const double steps_per_episode =
         record.episodes > 0.0 ? record.steps / record.episodes : 0.0;
-    report +=
-        fmt::format("{} {} {:.2f} ({:.0f} steps, w {:.3f})", i == 0 ? "" : ",",
-                    view_names_[v], failure[v], steps_per_episode, weights[v]);
+    report += fmt::format("{} {} {:.2f} ({:.0f} steps, w {:.3f})",
+                          listed == 0 ? "" : ",", view_names_[v], failure[v],
+                          steps_per_episode, weights[v]);
+    ++listed;
   }
   return report;
 }

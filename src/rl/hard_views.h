@@ -58,9 +58,9 @@ class HardViewSampler {
               int64_t batch_samples);
   std::vector<double> Weights() const;
   // A brief report: the mean failure chance over the views with episodes,
-  // then the `count` views most likely to fail, with that chance, their
-  // mean episode length (steps) and their start weight ("...; hardest:
-  // kick view 2 0.93 (12 steps, w 0.061), ...").
+  // then the `count` views with episodes and the largest start weights,
+  // each with its chance, mean episode length (steps) and weight ("...;
+  // hardest: kick view 2 0.93 (12 steps, w 0.061), ...").
   std::string Report(int count) const;
 
  private:

@@ -74,6 +74,31 @@ TEST(HardViews, HazardWeightsGiveFailingViewsEqualSamples) {
   EXPECT_NEAR(hazard[3] / hazard[0], known_mean / 0.1, 1e-12);
 }
 
+TEST(HardViews, TheHazardSamplerListsViewsByStartWeight) {
+  TrackingTask task = testing::MakeGlidingTask(/*num_views=*/2);
+  HardViewSampler sampler(*task.reference, /*share=*/1.0,
+                          /*half_life_samples=*/1000.0,
+                          HardViewMeasure::kHazard);
+  // Both views fail every episode, view 1 after 5 steps and view 0 after
+  // 50: view 1 gets 10x view 0's starts and is listed first.
+  auto failed_episode = [](int view, int steps) {
+    FinishedEpisode finished;
+    finished.stats.view_index = view;
+    finished.stats.steps = steps;
+    finished.stats.failed = true;
+    return finished;
+  };
+  sampler.Record({failed_episode(1, 5), failed_episode(0, 50)}, 1000);
+  const std::vector<double> weights = sampler.Weights();
+  EXPECT_NEAR(weights[1], 10.0 / 11.0, 1e-12);
+  EXPECT_NEAR(weights[0], 1.0 / 11.0, 1e-12);
+  const std::string report = sampler.Report(2);
+  EXPECT_NE(report.find("hardest: gliding view 1 1.00 (5 steps, w 0.909), "
+                        "gliding view 0 0.45 (50 steps, w 0.091)"),
+            std::string::npos)
+      << report;
+}
+
 TEST(HardViews, TheSamplerFavoursFailingViewsAndForgets) {
   TrackingTask task = testing::MakeGlidingTask(/*num_views=*/2);
   HardViewSampler sampler(*task.reference, /*share=*/1.0,
