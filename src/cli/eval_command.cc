@@ -19,6 +19,7 @@ struct EvalArgs {
   EvalOptions options;
   std::string starts;   // "": the checkpoint's config
   std::string cameras;  // "": the checkpoint's config
+  std::string camera;   // --camera; "": the checkpoint's config
   bool asi_starts = false;
   std::string success_measure = SettingName(FrameErrorMeasure::kWorst);
 };
@@ -31,6 +32,11 @@ int RunEval(const EvalArgs& args) {
   sources.checkpoint_buffers = args.asi_starts;
   EvalOptions options = args.options;
   ParseSetting(args.success_measure, &options.success_measure);  // checked
+  if (!args.camera.empty()) {
+    EpisodeCamera camera = EpisodeCamera::kRecorded;
+    ParseSetting(args.camera, &camera);  // checked
+    options.camera = camera;
+  }
   options.record_frames = !args.frames_output.empty();
   CheckpointEvaluation evaluation = EvaluateCheckpoint(
       args.checkpoint, args.bundles, options, sources, args.truth_bundles);
@@ -114,6 +120,13 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
                    "Cameras from: truth or estimate (default: the "
                    "checkpoint's config)")
       ->check(CLI::IsMember({"truth", "estimate"}));
+  eval->add_option("--camera", args->camera,
+                   "The episodes' camera: recorded (each frame's as the "
+                   "cameras source has it) or follows_character (moved "
+                   "with the simulated root's offset from the initial "
+                   "states' root; default: the checkpoint's env.camera)")
+      ->check(CLI::IsMember({SettingName(EpisodeCamera::kRecorded),
+                             SettingName(EpisodeCamera::kFollowsCharacter)}));
   eval->add_flag("--asi-starts", args->asi_starts,
                  "Start episodes from the checkpoint's ASI buffers (the "
                  "starts as training refined them) instead of fresh ones; "

@@ -203,6 +203,7 @@ CheckpointEvaluation EvaluateCheckpoint(
     truth.push_back(truth_bundle.ground_truth);
   }
   evaluation.keypoint_names = task.character->keypoint_layout().keypoint_names;
+  evaluation.camera = options.camera.value_or(config.env.camera);
   evaluation.rows =
       EvaluatePolicy(policy, task.character, task.reference,
                      task.initial_states, config.env, options, truth);
@@ -215,6 +216,12 @@ void PrintEvalTable(const CheckpointEvaluation& evaluation) {
     std::printf(
         "episodes start from the checkpoint's ASI buffers: those states as "
         "training refined them in simulation (no 3D truth)\n");
+  }
+  if (evaluation.camera == EpisodeCamera::kFollowsCharacter) {
+    std::printf(
+        "the cameras follow the character: each frame's camera moved with "
+        "the simulated root's offset from the initial states' motion's root "
+        "(env.camera follows_character)\n");
   }
   if (evaluation.sources.cameras == CameraSource::kEstimate) {
     std::printf(
@@ -270,6 +277,7 @@ void WriteEvalJson(const std::string& path, const std::string& checkpoint,
       {"starts", SourceName(evaluation.sources.initial_states)},
       {"cameras", SourceName(evaluation.sources.cameras)},
       {"starts_from_checkpoint_buffers", evaluation.checkpoint_buffers},
+      {"camera", SettingName(evaluation.camera)},
       {"episode_s", options.episode_s},
       {"success_threshold_px", options.success_threshold_px},
       {"success_measure", SettingName(options.success_measure)},

@@ -34,7 +34,8 @@ struct SourceOverrides {
 struct CheckpointEvaluation {
   TaskSources sources;              // the ones the rollouts used
   bool checkpoint_buffers = false;  // starts from the checkpoint's buffers
-  std::vector<std::string> keypoint_names;  // the character's, by index
+  EpisodeCamera camera = EpisodeCamera::kRecorded;  // the episodes'
+  std::vector<std::string> keypoint_names;          // the character's, by index
   std::vector<EvalRow> rows;
 };
 

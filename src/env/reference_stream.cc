@@ -34,6 +34,9 @@ StreamedRollout::StreamedRollout(std::shared_ptr<const Character> character,
   options_.Validate();
   if (options_.target != TrackingTarget::kImage2D)
     throw ConfigError("a streamed reference is 2D: env.target image_2d");
+  // The stream's cameras are asked of `camera` each step, following the
+  // character already when it dollies; the env projects with them as given.
+  options_.camera = EpisodeCamera::kRecorded;
   const Clip2D& format = stream_->format();
   if (format.layout != &character_->keypoint_layout()) {
     throw InputError("reference stream",

@@ -84,6 +84,14 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
           "or estimate, not default");
     }
   }
+  if (options_.camera == EpisodeCamera::kFollowsCharacter &&
+      (initial_states_ == nullptr ||
+       reference_->sources().initial_states == InitialStateSource::kDefault)) {
+    // The camera follows the character relative to a motion's root.
+    throw ConfigError(
+        "env: camera follows_character needs the motion the initial states "
+        "come from: initial_states truth or estimate, not default");
+  }
   if (options_.object_start_square_m > 0 &&
       reference_->num_object_points() == 0) {
     throw ConfigError(
@@ -103,6 +111,7 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
   const int num_keypoints = character->keypoint_layout().num_keypoints();
   keypoints_xyz_.resize(3 * num_keypoints);
   current_points_m_.resize(num_points);
+  cameras_.resize(num_observed_views);
   projected_xy_.resize(2 * num_points * num_observed_views);
   in_front_.reset(new bool[num_points * num_observed_views]);
   projected_points_.resize(num_points * num_observed_views);
@@ -344,17 +353,44 @@ StepOutcome TrackingEnv::Step(const float* action, float* observation) {
   return outcome;
 }
 
+PinholeCamera CameraFollowingCharacter(
+    const PinholeCamera& recorded, const Eigen::Vector3d& reference_root_m,
+    const Eigen::Vector3d& simulated_root_m) {
+  const Eigen::Vector3d offset_m = simulated_root_m - reference_root_m;
+  return recorded.Translated({offset_m.x(), offset_m.y(), 0.0});
+}
+
+void TrackingEnv::PlaceCameras() {
+  for (int k = 0; k < num_observed_views_; ++k) {
+    const TrackedView& view = *observed_views_[k];
+    cameras_[k] =
+        reference_->bundles()[view.bundle].views[view.view].CameraAt(frame_);
+  }
+  if (options_.camera == EpisodeCamera::kRecorded) return;
+  // One offset for every view: the observed views of an episode share the
+  // episode view's world (ResetToViews), where the simulation is.
+  const double* root_qpos =
+      simulation_.data()->qpos + simulation_.character().root_qpos_address();
+  const Eigen::Vector3d simulated_root_m(root_qpos[0], root_qpos[1],
+                                         root_qpos[2]);
+  const Eigen::Vector3d& reference_root_m =
+      ReferenceBody(frame_).root_position_m;
+  for (PinholeCamera& camera : cameras_) {
+    camera =
+        CameraFollowingCharacter(camera, reference_root_m, simulated_root_m);
+  }
+}
+
 void TrackingEnv::ProjectCurrentPoints() {
   // Outline: the keypoints (and objects) in the world once, then through
   // each observed view's camera at the current frame.
+  PlaceCameras();
   const mjData* data = simulation_.data();
   simulation_.KeypointPositions(keypoints_xyz_.data());
   const int num_keypoints = static_cast<int>(keypoints_xyz_.size() / 3);
   const int num_points = layout_.num_points;
   for (int k = 0; k < num_observed_views_; ++k) {
-    const TrackedView& view = *observed_views_[k];
-    const PinholeCamera& camera =
-        reference_->bundles()[view.bundle].views[view.view].CameraAt(frame_);
+    const PinholeCamera& camera = cameras_[k];
     for (int j = 0; j < num_points; ++j) {
       Eigen::Vector3d point;
       if (j < num_keypoints) {
@@ -494,8 +530,7 @@ void TrackingEnv::WriteCriticOnlyBlock(float* observation) const {
   }
   const BodyTarget3D& now = ReferenceBody(frame_);
   const BodyTarget3D& next = ReferenceBody(frame_ + 1);
-  const PinholeCamera& camera =
-      reference_->bundles()[view_->bundle].views[view_->view].CameraAt(frame_);
+  const PinholeCamera& camera = cameras_.front();
   WriteCriticOnlyInputs(
       bodies_, now.keypoints_m.data(), next.keypoints_m.data(),
       static_cast<int>(now.keypoints_m.size()), camera.CenterWorld(),

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "camera/pinhole.h"
 #include "common/settings.h"
 #include "env/observation.h"
 #include "env/reference.h"
@@ -38,6 +39,37 @@ inline bool ParseSetting(const std::string& text, TrackingTarget* target) {
 inline std::string SettingChoices(TrackingTarget) {
   return "image_2d, body_3d";
 }
+
+// Where an episode's camera is at each frame.
+enum class EpisodeCamera {
+  kRecorded,  // the view's camera of the frame, as recorded (or fitted)
+  // The view's camera of the frame moved horizontally by the simulated
+  // root's offset from the reference motion's root at the frame (the
+  // motion the initial states come from: the fit's poses with
+  // initial_states estimate): a camera that dollies with the character,
+  // for views filmed by one that dollied with the subject (`clip
+  // from-motion --follow`, a following video), whose 2D holds the body
+  // but not its path over the ground. The rollouts of `generate --policy`
+  // see the character so.
+  kFollowsCharacter,
+};
+inline const char* SettingName(EpisodeCamera camera) {
+  return camera == EpisodeCamera::kRecorded ? "recorded" : "follows_character";
+}
+inline bool ParseSetting(const std::string& text, EpisodeCamera* camera) {
+  return ParseSettingByName(
+      text, {EpisodeCamera::kRecorded, EpisodeCamera::kFollowsCharacter},
+      camera);
+}
+inline std::string SettingChoices(EpisodeCamera) {
+  return "recorded, follows_character";
+}
+
+// `recorded` moved horizontally by the offset of `simulated_root_m` from
+// `reference_root_m` (world, m): EpisodeCamera::kFollowsCharacter's camera.
+PinholeCamera CameraFollowingCharacter(const PinholeCamera& recorded,
+                                       const Eigen::Vector3d& reference_root_m,
+                                       const Eigen::Vector3d& simulated_root_m);
 
 // Synthetic detector noise on the 2D reference of an episode.
 struct ReferenceNoise {
@@ -108,6 +140,7 @@ struct TrackingEnvOptions {
   // starts. 0: uniform, drawing nothing extra (runs stay bit-identical).
   double first_frame_start_share = 0.0;
   PushOptions pushes;  // none by default
+  EpisodeCamera camera = EpisodeCamera::kRecorded;
   // Moved objects: every episode's tracked objects (a ball) start offset on
   // the floor, uniformly in a square of this side (m) about where the start
   // state has them, drawn from the environment's seed. The paper's "w/ Rnd."
@@ -151,6 +184,13 @@ struct TrackingEnvOptions {
       "instead of a uniformly drawn one; 0: uniform");
     v.Nested("reward", self.reward);
     v.Nested("pushes", self.pushes);
+    v("camera", self.camera, Range::Any(),
+      "recorded (each frame's camera as the view has it: true or fitted) "
+      "or follows_character (that camera moved horizontally by the "
+      "simulated root's offset from the initial states' motion's root at "
+      "the frame: a camera dollying with the character, for following "
+      "views, whose 2D holds no path over the ground; needs initial_states "
+      "truth or estimate)");
     v("object_start_square_m", self.object_start_square_m, Range::AtLeast(0),
       "each episode's tracked objects (the ball) start moved on the floor "
       "uniformly within a square of this side (m) about their start; 0: "
@@ -261,6 +301,9 @@ class TrackingEnv {
   // current frame (x, y per point; valid after Reset/Step); with K views,
   // the other views' follow in order.
   const std::vector<double>& projected_px() const { return projected_xy_; }
+  // The camera the k-th observed view projects with at the current frame
+  // (options' `camera`; valid after Reset/Step).
+  const PinholeCamera& camera(int k = 0) const { return cameras_[k]; }
   // Per point: whether it is in front of the episode's camera (then the
   // other views').
   const bool* in_front() const { return in_front_.get(); }
@@ -275,6 +318,8 @@ class TrackingEnv {
   // With reference noise: the episode's noisy views hold frames up to
   // `last_frame` (drawn the first time an episode reaches them).
   void CorruptReferenceUpTo(int last_frame);
+  // Each observed view's camera at the current frame (cameras_).
+  void PlaceCameras();
   void ProjectCurrentPoints();
   // A horizontal force of `force_n` at `heading_rad` on the root body
   // (world frame; 0 N clears it). MuJoCo keeps xfrc_applied until changed.
@@ -315,6 +360,8 @@ class TrackingEnv {
   std::normal_distribution<double> unit_normal_{0.0, 1.0};
   std::uniform_real_distribution<double> unit_uniform_{0.0, 1.0};
 
+  // Each observed view's camera at the current frame (PlaceCameras).
+  std::vector<PinholeCamera> cameras_;
   // Scratch buffers, sized once (per observed view where projected).
   BodyKinematics bodies_;
   std::vector<double> keypoints_xyz_;

@@ -124,6 +124,7 @@ std::vector<EvalRow> EvaluatePolicy(
   eval_env.reward_3d.early_exit_max_error_m = 0.0;
   eval_env.pushes = options.pushes;
   eval_env.object_start_square_m = options.object_start_square_m;
+  if (options.camera) eval_env.camera = *options.camera;
   if (options.object_start_square_m > 0 &&
       reference->num_object_points() == 0) {
     throw InputError("evaluation",

@@ -39,6 +39,9 @@ struct EvalOptions {
   PushOptions pushes;
   double object_start_square_m = 0.0;
   uint64_t perturbation_seed = 1;
+  // The episodes' camera (env/tracking_env.h); unset: the policy's training
+  // setting (its config's env.camera).
+  std::optional<EpisodeCamera> camera;
   // Keep every rollout's per-frame errors (EvalRollout::trace; eval
   // --frames): where and on which keypoint a rollout starts to fail.
   bool record_frames = false;

@@ -6,12 +6,11 @@ namespace {
 EpisodeFrame CurrentFrame(const TrackingEnv& env,
                           const TrackingReference& reference) {
   const TrackedView& view = env.view();
-  const ReferenceBundle& bundle = reference.bundles()[view.bundle];
   const int num_keypoints =
       env.simulation().character().keypoint_layout().num_keypoints();
   EpisodeFrame frame;
   frame.clip_frame = env.frame();
-  frame.camera = bundle.views[view.view].CameraAt(env.frame());
+  frame.camera = env.camera();  // recorded, or following the character
   const Keypoint2D* points = view.frame(env.frame());
   frame.reference.assign(points, points + num_keypoints);
   // The objects' reference in the scene's free-object order (missing where

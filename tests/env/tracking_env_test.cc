@@ -555,5 +555,76 @@ TEST(TrackingEnv, TheCriticOnlyBlockAddsTheReferenceAndCameraAndNothingElse) {
   for (int i = 0; i < CriticOnlySize(17); ++i) EXPECT_EQ(c[base + i], 0.0f);
 }
 
+// camera follows_character: the camera moves with the simulated root's
+// offset from the reference motion's root, so a character displaced on the
+// ground is seen, rewarded and judged exactly as where it was (its path over
+// the ground is not in the 2D); recorded cameras see the displacement. A
+// streamed rollout's env has no motion to follow from.
+TEST(TrackingEnv, AFollowingCameraSeesADisplacedCharacterAsIfItWereNot) {
+  const PinholeCamera recorded =
+      PinholeCamera::LookAt(Intrinsics{1000, 1000, 960, 540, 1920, 1080},
+                            {4, 0, 1.5}, {0, 0, 1}, {0, 0, 1});
+  const PinholeCamera moved =
+      CameraFollowingCharacter(recorded, {1.0, 2.0, 0.9}, {1.5, 1.0, 0.7});
+  EXPECT_LT((moved.CenterWorld() - recorded.CenterWorld() -
+             Eigen::Vector3d(0.5, -1.0, 0.0))
+                .norm(),
+            1e-12);  // horizontal only: a root that sinks does not lower it
+
+  M2D_REQUIRE_SHARED(path, "deepmimic/motions/humanoid3d_walk.txt");
+  testing::WalkTask task = testing::MakeWalkTask(path, 3.0);
+  TrackingEnvOptions following_options = task.options;
+  following_options.camera = EpisodeCamera::kFollowsCharacter;
+  TrackingEnv recorded_env(task.character, task.reference, task.initial_states,
+                           task.options, 1);
+  TrackingEnv following(task.character, task.reference, task.initial_states,
+                        following_options, 1);
+  TrackingEnv following_displaced(task.character, task.reference,
+                                  task.initial_states, following_options, 1);
+  const int frame = 12;
+  const SimState& start = *task.initial_states->buffer(0).anchor(frame);
+  SimState displaced = start;
+  const int root = task.character->root_qpos_address();
+  displaced.qpos[root] += 0.4;
+  displaced.qpos[root + 1] -= 0.3;
+
+  // At the start the root is the reference's: both cameras are the recorded.
+  std::vector<float> a(recorded_env.observation_size()),
+      b(following.observation_size()), c(following.observation_size());
+  recorded_env.ResetTo(0, frame, start, a.data());
+  following.ResetTo(0, frame, start, b.data());
+  following_displaced.ResetTo(0, frame, displaced, c.data());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(b[i], a[i]) << i;
+    ASSERT_NEAR(c[i], a[i], 1e-4) << i;
+  }
+  EXPECT_LT(
+      (following_displaced.camera().CenterWorld() -
+       recorded_env.camera().CenterWorld() - Eigen::Vector3d(0.4, -0.3, 0.0))
+          .norm(),
+      1e-9);
+  std::vector<float> action(recorded_env.action_size(), 0.1f);
+  for (int step = 0; step < 5; ++step) {
+    StepOutcome expected = following.Step(action.data(), b.data());
+    StepOutcome outcome = following_displaced.Step(action.data(), c.data());
+    ASSERT_FALSE(expected.terminated);
+    ASSERT_FALSE(outcome.terminated);
+    // Flat ground: the physics is the same up to rounding.
+    EXPECT_NEAR(outcome.reward, expected.reward, 1e-4) << step;
+    EXPECT_NEAR(outcome.error.mean_px, expected.error.mean_px, 1e-3) << step;
+    for (size_t i = 0; i < b.size(); ++i)
+      ASSERT_NEAR(c[i], b[i], 1e-3) << "step " << step << ", input " << i;
+  }
+
+  // Recorded cameras see the displacement (0.5 m at 4.5 m: about 100 px).
+  recorded_env.ResetTo(0, frame, displaced, a.data());
+  StepOutcome outcome = recorded_env.Step(action.data(), a.data());
+  EXPECT_TRUE(outcome.terminated || outcome.error.mean_px > 30.0);
+
+  EXPECT_THROW(TrackingEnv(task.character, task.reference, nullptr,
+                           following_options, 1),
+               ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
