@@ -530,6 +530,23 @@ TEST(Cli, ClipStripKeepsOnlyThe2D) {
   EXPECT_EQ(eval["cameras"], "estimate");
   EXPECT_TRUE(eval["all"]["e3d_mm"].is_null());  // worlds differ
   EXPECT_TRUE(eval["all"]["e3d_pa_mm"].is_number());
+  EXPECT_EQ(eval["camera"], "recorded");  // the checkpoint's env.camera
+  // --camera: the episodes' camera, said in the header and the JSON.
+  const std::string following_json = dir + "/eval_following.json";
+  result = RunMimic2d("eval " + policy + " --bundle " + full +
+                      " --starts estimate --cameras estimate --camera "
+                      "follows_character --episodes 1 --episode-s 0.3 -o " +
+                      following_json);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("the cameras follow the character"),
+            std::string::npos)
+      << result.output;
+  EXPECT_EQ(ReadJsonFile(following_json)["camera"], "follows_character");
+  result = RunMimic2d("eval " + policy + " --bundle " + full +
+                      " --camera sideways --episodes 1");
+  EXPECT_NE(result.exit_code, 0) << result.output;  // CLI11's validation
+  EXPECT_NE(result.output.find("--camera: sideways not in"), std::string::npos)
+      << result.output;
   // The stripped-and-fitted file measured against the original's truth
   // (--truth) gives the same figures: the rollouts never read it.
   const std::string stripped_json = dir + "/eval_stripped.json";
