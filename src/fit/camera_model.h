@@ -8,6 +8,7 @@
 #define MIMIC2D_FIT_CAMERA_MODEL_H_
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -79,6 +80,24 @@ void FitProjectTurned(const T& focal_px, const T* pitch_roll_rad,
   const T point[3] = {cy * point_m[0] + sy * point_m[1],
                       -sy * point_m[0] + cy * point_m[1], point_m[2]};
   FitProject(focal_px, pitch_roll_rad, centre, point, cx_px, cy_px, pixel_px);
+}
+
+// A rigid body (its root's position and orientation) seen by one camera
+// (world-to-camera rotation, centre), placed where another camera sees it
+// exactly alike: the two fits of one view whose worlds differ in the
+// camera's pitch, roll and path (fit.cc, stage 5).
+struct RootPlacement {
+  Eigen::Vector3d position_m;
+  Eigen::Quaterniond orientation;
+};
+inline RootPlacement CarryBetweenCameras(const Eigen::Matrix3d& from_rotation,
+                                         const Eigen::Vector3d& from_centre_m,
+                                         const Eigen::Matrix3d& to_rotation,
+                                         const Eigen::Vector3d& to_centre_m,
+                                         const RootPlacement& body) {
+  const Eigen::Matrix3d to_from_from = to_rotation.transpose() * from_rotation;
+  return {to_centre_m + to_from_from * (body.position_m - from_centre_m),
+          (Eigen::Quaterniond(to_from_from) * body.orientation).normalized()};
 }
 
 // The estimated camera as a PinholeCamera for an image of the given size.

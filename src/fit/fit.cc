@@ -1327,14 +1327,12 @@ ViewEstimate ReportView(const Observations& obs, const KinematicModel& model,
 }
 
 // Stages 2 to 4 from `best` over its camera and, for a rig, its other
-// cameras (`rig_obs` their views); returns the first camera's estimate
-// (ReportView), `summary` given the iterations and final cost.
-ViewEstimate SolvePoseAndReport(
-    const Observations& obs, const KinematicModel& model,
-    const KeypointLayout& layout, const Character& character,
-    const FitOptions& options, const FitPriors& priors,
-    std::chrono::steady_clock::time_point started, FitSummary& summary,
-    Parameters& best, const std::vector<Observations>& rig_obs = {}) {
+// cameras (`rig_obs` their views); `summary` given the iterations and final
+// cost.
+void SolvePose(const Observations& obs, const KinematicModel& model,
+               const KeypointLayout& layout, const FitOptions& options,
+               const FitPriors& priors, FitSummary& summary, Parameters& best,
+               const std::vector<Observations>& rig_obs = {}) {
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
@@ -1389,6 +1387,16 @@ ViewEstimate SolvePoseAndReport(
         std::to_string(final_stage.final_cost) + Seconds(final_stage.seconds));
   }
   summary.final_cost = final_stage.final_cost;
+}
+
+// SolvePose, then the first camera's estimate (ReportView).
+ViewEstimate SolvePoseAndReport(
+    const Observations& obs, const KinematicModel& model,
+    const KeypointLayout& layout, const Character& character,
+    const FitOptions& options, const FitPriors& priors,
+    std::chrono::steady_clock::time_point started, FitSummary& summary,
+    Parameters& best, const std::vector<Observations>& rig_obs = {}) {
+  SolvePose(obs, model, layout, options, priors, summary, best, rig_obs);
   return ReportView(obs, model, character, options, best.camera, started,
                     summary, best);
 }
@@ -1601,23 +1609,31 @@ void FitOptions::Validate() const {
     throw ConfigError("fit.pitch_starts_deg needs at least one pitch");
 }
 
-ViewEstimate FitView(const Clip2D& clip, const Character& character,
-                     const FitOptions& options, const std::string& source) {
+// A clip's observations, priors and estimate (FitWholeClip).
+struct ClipFit {
+  Observations obs;
+  FitPriors priors;
+  Parameters params;
+};
+
+// Stages 1 to 4 over the whole of one view's `clip`; `summary` given the
+// starts, iterations and costs.
+ClipFit FitWholeClip(const Clip2D& clip, const Character& character,
+                     const KinematicModel& model, const FitOptions& options,
+                     const std::string& source, FitSummary& summary) {
   // Outline: read the usable observations; stage 1 fits camera and root
   // trajectory from several facing starts and keeps the lowest cost;
-  // stage 2 frees the pose; stage 3 adds non-sliding feet at the contacts
-  // stage 2 found; stage 4 refines the pose under the camera held, with
-  // weaker smoothness; then report per-frame residuals and the frames that
-  // did not converge.
-  options.Validate();
-  const auto started = std::chrono::steady_clock::now();
-  const KinematicModel model = KinematicModel::FromCharacter(character);
-  const Observations obs =
-      ReadCharacterObservations(clip, character, options, source);
+  // stage 1b searches each limb frame by frame; stage 2 frees the pose;
+  // stage 3 adds non-sliding feet at the contacts stage 2 found; stage 4
+  // refines the pose under the camera held, with weaker smoothness.
+  ClipFit fit;
+  fit.obs = ReadCharacterObservations(clip, character, options, source);
+  const Observations& obs = fit.obs;
   const RestPose rest = MakeRestPose(model, *clip.layout);
   const std::vector<Limb> limbs = FindLimbs(model);
-  const FitPriors priors =
+  fit.priors =
       MakeFitPriors(character, model, *clip.layout, options, obs, source);
+  const FitPriors& priors = fit.priors;
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
@@ -1631,7 +1647,6 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
         " frames (a 2D ankle still or unseen)");
   }
 
-  FitSummary summary;
   summary.camera_model = CameraMotionName(options.camera_motion);
   summary.focal_fixed = options.fixed_focal_px > 0;
   summary.num_frames = obs.num_frames;
@@ -1642,7 +1657,7 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
   // full-pose cost continues. The torso alone hardly tells a walker seen
   // from the side facing left from one facing right (their stage 1 costs
   // tie); the legs do. Yaw pi faces the camera (which looks along +x).
-  Parameters best;
+  Parameters& best = fit.params;
   double best_cost = std::numeric_limits<double>::infinity();
   double best_turn_deg = 0.0;
   double best_pitch_deg = options.pitch_starts_deg[0];
@@ -1710,9 +1725,188 @@ ViewEstimate FitView(const Clip2D& clip, const Character& character,
                                               search_started)
                     .count()));
   }
+  SolvePose(obs, model, *clip.layout, options, priors, summary, best);
+  return fit;
+}
+
+// Per frame, the mean pixel distance of its confident keypoints from their
+// projection (FrameResidualPx; -1: none); `mean_px` the weighted mean over
+// the clip.
+std::vector<double> FrameResiduals(const Observations& obs,
+                                   const KinematicModel& model,
+                                   Parameters& params, double* mean_px) {
+  std::vector<double> residuals(obs.num_frames);
+  double weighted_sum = 0.0, weight_total = 0.0;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    residuals[t] = FrameResidualPx(obs, model, params.camera, params, t,
+                                   &weighted_sum, &weight_total);
+  }
+  *mean_px = weight_total > 0 ? weighted_sum / weight_total : 0.0;
+  return residuals;
+}
+
+// Frame `t` of `params` given `part`'s pose at its frame `u` as `part`'s
+// camera sees it: the body where it stands relative to the camera, carried
+// into `params`'s camera (the two fits' worlds differ in the camera's
+// pitch, roll and path).
+void SpliceSeenPose(const Parameters& part, int u, int t, Parameters& params) {
+  const Eigen::Vector4d& q = part.quaternion_wxyz[u];
+  const RootPlacement placed = CarryBetweenCameras(
+      FitCameraRotation(part.camera.pitch_roll_rad, part.camera.yaw_rad),
+      Eigen::Vector3d(part.camera.centre(u)),
+      FitCameraRotation(params.camera.pitch_roll_rad, params.camera.yaw_rad),
+      Eigen::Vector3d(params.camera.centre(t)),
+      {part.root_m[u], Eigen::Quaterniond(q[0], q[1], q[2], q[3])});
+  params.root_m[t] = placed.position_m;
+  params.quaternion_wxyz[t] =
+      Eigen::Vector4d(placed.orientation.w(), placed.orientation.x(),
+                      placed.orientation.y(), placed.orientation.z());
+  params.hinges_rad[t] = part.hinges_rad[u];
+}
+
+// Stage 5: the stretches the whole-clip solve left in a wrong basin, fitted
+// again alone. A long clip's one start suits most of it, and the smooth
+// terms hold a stretch that went wrong where it is.
+void RefitStretches(const Clip2D& clip, const Character& character,
+                    const KinematicModel& model, const FitOptions& options,
+                    const std::string& source, FitSummary& summary,
+                    ClipFit& fit) {
+  // Outline: find the stretches of usable frames above the residual
+  // threshold; fit each, with context on both sides, as a clip of its own
+  // (stages 1-4); splice its poses, as its camera sees them, into the
+  // stretch where they explain the 2D better; stages 2-4 again over the
+  // whole clip from the spliced start; keep that only if the clip's mean
+  // reprojection fell.
+  const auto stage_started = std::chrono::steady_clock::now();
+  const Observations& obs = fit.obs;
+  const double threshold_px =
+      options.window_refit_residual_scale * obs.median_scale_px;
+  double mean_px = 0.0;
+  const std::vector<double> residuals =
+      FrameResiduals(obs, model, fit.params, &mean_px);
+  struct Stretch {
+    int first, last;
+  };
+  std::vector<Stretch> stretches;
+  for (int t = 0; t < obs.num_frames; ++t) {
+    if (!obs.usable[t] || residuals[t] <= threshold_px) continue;
+    if (!stretches.empty() && stretches.back().last == t - 1)
+      stretches.back().last = t;
+    else
+      stretches.push_back({t, t});
+  }
+  if (stretches.empty()) return;
+  // Windows: each stretch with its context, overlapping ones merged.
+  struct Window {
+    int first, last;
+    std::vector<Stretch> stretches;
+  };
+  std::vector<Window> windows;
+  const int context = options.window_refit_context_frames;
+  for (const Stretch& stretch : stretches) {
+    const int first = std::max(0, stretch.first - context);
+    const int last = std::min(obs.num_frames - 1, stretch.last + context);
+    if (!windows.empty() && first <= windows.back().last + 1) {
+      windows.back().last = last;
+      windows.back().stretches.push_back(stretch);
+    } else {
+      windows.push_back({first, last, {stretch}});
+    }
+  }
+  FitOptions part_options = options;
+  part_options.window_refit_residual_scale = 0.0;
+  part_options.progress = nullptr;
+  Parameters spliced = fit.params;
+  int frames_above = 0, frames_spliced = 0;
+  for (const Window& window : windows) {
+    for (const Stretch& stretch : window.stretches)
+      frames_above += stretch.last - stretch.first + 1;
+    const int count = window.last - window.first + 1;
+    // The whole clip again is the problem already solved.
+    if (count == obs.num_frames) continue;
+    ClipFit part;
+    FitSummary part_summary;
+    try {
+      part = FitWholeClip(ClipFrames(clip, window.first, count), character,
+                          model, part_options, source, part_summary);
+    } catch (const InputError&) {
+      continue;  // a window the fit cannot use alone (too few usable frames)
+    }
+    summary.iterations += part_summary.iterations;
+    double part_mean_px = 0.0;
+    const std::vector<double> part_residuals =
+        FrameResiduals(part.obs, model, part.params, &part_mean_px);
+    for (const Stretch& stretch : window.stretches) {
+      double before = 0.0, after = 0.0;
+      for (int t = stretch.first; t <= stretch.last; ++t) {
+        before += std::max(0.0, residuals[t]);
+        after += std::max(0.0, part_residuals[t - window.first]);
+      }
+      if (after >= before) continue;
+      for (int t = stretch.first; t <= stretch.last; ++t)
+        SpliceSeenPose(part.params, t - window.first, t, spliced);
+      frames_spliced += stretch.last - stretch.first + 1;
+    }
+  }
+  char line[240];
+  if (frames_spliced == 0) {
+    std::snprintf(line, sizeof(line),
+                  "stage 5 (stretches refitted): %d frames in %zu stretches "
+                  "above %.1f px; none fitted better alone%s",
+                  frames_above, stretches.size(), threshold_px,
+                  Seconds(std::chrono::duration<double>(
+                              std::chrono::steady_clock::now() - stage_started)
+                              .count())
+                      .c_str());
+    if (options.progress) options.progress(line);
+    return;
+  }
+  FitSummary resolved = summary;
+  SolvePose(obs, model, *clip.layout, options, fit.priors, resolved, spliced);
+  double spliced_mean_px = 0.0;
+  const std::vector<double> spliced_residuals =
+      FrameResiduals(obs, model, spliced, &spliced_mean_px);
+  const bool kept = spliced_mean_px < mean_px;
+  const int frames_left = static_cast<int>(
+      std::count_if(spliced_residuals.begin(), spliced_residuals.end(),
+                    [&](double r) { return r > threshold_px; }));
+  std::snprintf(
+      line, sizeof(line),
+      "stage 5 (stretches refitted): %d frames in %zu stretches above %.1f "
+      "px, %d spliced from their own fits; mean reprojection %.2f -> %.2f "
+      "px, %d frames above (%s)%s",
+      frames_above, stretches.size(), threshold_px, frames_spliced, mean_px,
+      spliced_mean_px, kept ? frames_left : frames_above,
+      kept ? "kept" : "not kept",
+      Seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                            stage_started)
+                  .count())
+          .c_str());
+  if (options.progress) options.progress(line);
+  if (kept) {
+    fit.params = std::move(spliced);
+    summary = resolved;
+  } else {
+    summary.iterations = resolved.iterations;
+  }
+}
+
+ViewEstimate FitView(const Clip2D& clip, const Character& character,
+                     const FitOptions& options, const std::string& source) {
+  // Outline: stages 1 to 4 over the whole clip (FitWholeClip); stage 5
+  // fits the stretches left with high residuals again alone and splices
+  // them in (RefitStretches); then report per-frame residuals and the
+  // frames that did not converge, and place the clip's objects.
+  options.Validate();
+  const auto started = std::chrono::steady_clock::now();
+  const KinematicModel model = KinematicModel::FromCharacter(character);
+  FitSummary summary;
+  ClipFit fit = FitWholeClip(clip, character, model, options, source, summary);
+  if (options.window_refit_residual_scale > 0)
+    RefitStretches(clip, character, model, options, source, summary, fit);
   ViewEstimate estimate =
-      SolvePoseAndReport(obs, model, *clip.layout, character, options, priors,
-                         started, summary, best);
+      ReportView(fit.obs, model, character, options, fit.params.camera, started,
+                 summary, fit.params);
   PlaceObjects(clip, options, source, &estimate);
   return estimate;
 }

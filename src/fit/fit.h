@@ -174,6 +174,16 @@ struct FitOptions {
   int screening_iterations = 10;   // stage 2's screening, per facing start
   int pose_stage_iterations = 50;
   int refine_iterations = 50;  // stage 4; 0: no refinement
+  // Stage 5 (one view, not a rig): stretches of frames whose mean
+  // reprojection error exceeds this fraction of the person's size after
+  // stage 4 are fitted again as a clip of their own, with this many frames
+  // of context on each side, and spliced in where they explain the 2D
+  // better; stages 2-4 then run again over the whole clip. A long clip's one
+  // start and smooth terms can hold a stretch in a wrong basin (the stealthy
+  // walk's side views: 37-131 frames at 18-25 px beside 0.7 px elsewhere).
+  // 0: off.
+  double window_refit_residual_scale = 0.1;
+  int window_refit_context_frames = 45;
   int num_threads = 1;
   double function_tolerance = 1e-6;  // relative cost change that stops
   // A frame whose mean reprojection error exceeds this fraction of the
@@ -300,6 +310,13 @@ struct FitOptions {
       Range::Closed(1, 100000), "full-pose iterations per round");
     v("refine_iterations", self.refine_iterations, Range::Closed(0, 100000),
       "stage 4 iterations (0: no refinement)");
+    v("window_refit_residual_scale", self.window_refit_residual_scale,
+      Range::AtLeast(0),
+      "stage 5: stretches whose mean error exceeds this many person sizes "
+      "are fitted again alone and spliced in (0: off)");
+    v("window_refit_context_frames", self.window_refit_context_frames,
+      Range::Closed(0, 100000),
+      "stage 5: frames of context on each side of a stretch fitted again");
     v("num_threads", self.num_threads, Range::Closed(1, 1024), "Ceres threads");
     v("function_tolerance", self.function_tolerance, Range::Above(0),
       "relative cost change that stops a solve");

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "common/error.h"
 
@@ -111,6 +113,28 @@ Clip2D ResampleClip(const Clip2D& clip, double fps) {
       out.objects[o].points[t] = BlendKeypoints(
           clip.objects[o].points[before], clip.objects[o].points[after], alpha);
     }
+  }
+  return out;
+}
+
+Clip2D ClipFrames(const Clip2D& clip, int first, int count) {
+  if (first < 0 || count < 0 || first + count > clip.num_frames()) {
+    throw std::out_of_range("ClipFrames: frames [" + std::to_string(first) +
+                            ", " + std::to_string(first + count) +
+                            ") of a clip of " +
+                            std::to_string(clip.num_frames()));
+  }
+  Clip2D out = clip;
+  const int num_keypoints = clip.keypoints.num_keypoints();
+  out.keypoints = KeypointTrack(count, num_keypoints);
+  for (int t = 0; t < count; ++t) {
+    for (int j = 0; j < num_keypoints; ++j)
+      out.keypoints.at(t, j) = clip.keypoints.at(first + t, j);
+  }
+  for (size_t o = 0; o < clip.objects.size(); ++o) {
+    const std::vector<Keypoint2D>& points = clip.objects[o].points;
+    out.objects[o].points.assign(points.begin() + first,
+                                 points.begin() + first + count);
   }
   return out;
 }

@@ -88,6 +88,10 @@ void ValidateClip(const Clip2D& clip, const std::string& source);
 // otherwise; missing when neither does.
 Clip2D ResampleClip(const Clip2D& clip, double fps);
 
+// Frames [first, first + count) of `clip` (objects too), e.g. a stretch to
+// fit again alone. Throws std::out_of_range when they are not all in it.
+Clip2D ClipFrames(const Clip2D& clip, int first, int count);
+
 }  // namespace m2d
 
 #endif  // MIMIC2D_MOTION_CLIP2D_H_

@@ -659,5 +659,28 @@ TEST(ResampleClip, InterpolatesOverTheSameSpan) {
   EXPECT_THROW(ResampleClip(clip, 0.0), ConfigError);
 }
 
+// A stretch of a clip, to fit again alone: its frames and objects in
+// order; a stretch past the clip's end refused.
+TEST(ClipFrames, KeepsTheStretchsFramesAndObjects) {
+  Clip2D clip;
+  clip.keypoints = KeypointTrack(10, 17);
+  for (int t = 0; t < 10; ++t)
+    for (int j = 0; j < 17; ++j)
+      clip.keypoints.at(t, j) = {100.0 * t + j, 1.0 * t, 1.0};
+  clip.objects.push_back({"ball", {}});
+  for (int t = 0; t < 10; ++t)
+    clip.objects[0].points.push_back({5.0 * t, 0.0, 1.0});
+  const Clip2D part = ClipFrames(clip, 3, 4);
+  ASSERT_EQ(part.num_frames(), 4);
+  EXPECT_DOUBLE_EQ(part.keypoints.at(0, 0).x_px, 300.0);
+  EXPECT_DOUBLE_EQ(part.keypoints.at(3, 16).x_px, 616.0);
+  ASSERT_EQ(part.objects[0].points.size(), 4u);
+  EXPECT_DOUBLE_EQ(part.objects[0].points[3].x_px, 30.0);
+  EXPECT_DOUBLE_EQ(part.fps, clip.fps);
+  ValidateClip(part, "part");
+  EXPECT_THROW(ClipFrames(clip, 8, 3), std::out_of_range);
+  EXPECT_THROW(ClipFrames(clip, -1, 2), std::out_of_range);
+}
+
 }  // namespace
 }  // namespace m2d
