@@ -1822,8 +1822,10 @@ void RefitStretches(const Clip2D& clip, const Character& character,
     for (const Stretch& stretch : window.stretches)
       frames_above += stretch.last - stretch.first + 1;
     const int count = window.last - window.first + 1;
-    // The whole clip again is the problem already solved.
-    if (count == obs.num_frames) continue;
+    // A window holding most of the clip is the problem already solved: its
+    // own search would pick the start the whole clip's did. Stage 5 is for
+    // a stretch the clip's start does not suit.
+    if (2 * count > obs.num_frames) continue;
     ClipFit part;
     FitSummary part_summary;
     try {

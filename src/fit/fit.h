@@ -178,7 +178,8 @@ struct FitOptions {
   // reprojection error exceeds this fraction of the person's size after
   // stage 4 are fitted again as a clip of their own, with this many frames
   // of context on each side, and spliced in where they explain the 2D
-  // better; stages 2-4 then run again over the whole clip. A long clip's one
+  // better (a window over half the clip is skipped); stages 2-4 then run
+  // again over the whole clip. A long clip's one
   // start and smooth terms can hold a stretch in a wrong basin (the stealthy
   // walk's side views: 37-131 frames at 18-25 px beside 0.7 px elsewhere).
   // 0: off.
