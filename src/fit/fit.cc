@@ -1778,6 +1778,9 @@ void RefitStretches(const Clip2D& clip, const Character& character,
   // whole clip from the spliced start; keep that only if the clip's mean
   // reprojection fell.
   const auto stage_started = std::chrono::steady_clock::now();
+  auto say = [&](const std::string& line) {
+    if (options.progress) options.progress(line);
+  };
   const Observations& obs = fit.obs;
   const double threshold_px =
       options.window_refit_residual_scale * obs.median_scale_px;
@@ -1795,7 +1798,14 @@ void RefitStretches(const Clip2D& clip, const Character& character,
     else
       stretches.push_back({t, t});
   }
-  if (stretches.empty()) return;
+  if (stretches.empty()) {
+    char line[120];
+    std::snprintf(line, sizeof(line),
+                  "stage 5 (stretches refitted): no frame above %.1f px",
+                  threshold_px);
+    say(line);
+    return;
+  }
   // Windows: each stretch with its context, overlapping ones merged.
   struct Window {
     int first, last;
@@ -1818,37 +1828,66 @@ void RefitStretches(const Clip2D& clip, const Character& character,
   part_options.progress = nullptr;
   Parameters spliced = fit.params;
   int frames_above = 0, frames_spliced = 0;
-  for (const Window& window : windows) {
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const Window& window = windows[w];
+    const auto window_started = std::chrono::steady_clock::now();
+    int window_frames_above = 0;
     for (const Stretch& stretch : window.stretches)
-      frames_above += stretch.last - stretch.first + 1;
+      window_frames_above += stretch.last - stretch.first + 1;
+    frames_above += window_frames_above;
     const int count = window.last - window.first + 1;
+    char line[240];
+    std::snprintf(line, sizeof(line),
+                  "stage 5, window %zu/%zu: frames %d-%d (%d above %.1f px)",
+                  w + 1, windows.size(), window.first, window.last,
+                  window_frames_above, threshold_px);
     // A window holding most of the clip is the problem already solved: its
     // own search would pick the start the whole clip's did. Stage 5 is for
     // a stretch the clip's start does not suit.
-    if (2 * count > obs.num_frames) continue;
+    if (2 * count > obs.num_frames) {
+      say(std::string(line) + ": over half the clip, left");
+      continue;
+    }
     ClipFit part;
     FitSummary part_summary;
     try {
       part = FitWholeClip(ClipFrames(clip, window.first, count), character,
                           model, part_options, source, part_summary);
-    } catch (const InputError&) {
-      continue;  // a window the fit cannot use alone (too few usable frames)
+    } catch (const InputError& error) {
+      // A window the fit cannot use alone (too few usable frames).
+      say(std::string(line) + ": not fitted alone (" + error.what() + ")");
+      continue;
     }
     summary.iterations += part_summary.iterations;
     double part_mean_px = 0.0;
     const std::vector<double> part_residuals =
         FrameResiduals(part.obs, model, part.params, &part_mean_px);
+    double window_before = 0.0, window_after = 0.0;
+    int window_spliced = 0;
     for (const Stretch& stretch : window.stretches) {
       double before = 0.0, after = 0.0;
       for (int t = stretch.first; t <= stretch.last; ++t) {
         before += std::max(0.0, residuals[t]);
         after += std::max(0.0, part_residuals[t - window.first]);
       }
+      window_before += before;
+      window_after += after;
       if (after >= before) continue;
       for (int t = stretch.first; t <= stretch.last; ++t)
         SpliceSeenPose(part.params, t - window.first, t, spliced);
-      frames_spliced += stretch.last - stretch.first + 1;
+      window_spliced += stretch.last - stretch.first + 1;
     }
+    frames_spliced += window_spliced;
+    char result[160];
+    std::snprintf(result, sizeof(result),
+                  ": alone %.1f -> %.1f px on them, %d spliced%s",
+                  window_before / window_frames_above,
+                  window_after / window_frames_above, window_spliced,
+                  Seconds(std::chrono::duration<double>(
+                              std::chrono::steady_clock::now() - window_started)
+                              .count())
+                      .c_str());
+    say(std::string(line) + result);
   }
   char line[240];
   if (frames_spliced == 0) {
@@ -1860,7 +1899,7 @@ void RefitStretches(const Clip2D& clip, const Character& character,
                               std::chrono::steady_clock::now() - stage_started)
                               .count())
                       .c_str());
-    if (options.progress) options.progress(line);
+    say(line);
     return;
   }
   FitSummary resolved = summary;
@@ -1884,7 +1923,7 @@ void RefitStretches(const Clip2D& clip, const Character& character,
                                             stage_started)
                   .count())
           .c_str());
-  if (options.progress) options.progress(line);
+  say(line);
   if (kept) {
     fit.params = std::move(spliced);
     summary = resolved;
