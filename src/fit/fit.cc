@@ -1880,7 +1880,7 @@ void RefitStretches(const Clip2D& clip, const Character& character,
     frames_spliced += window_spliced;
     char result[160];
     std::snprintf(result, sizeof(result),
-                  ": alone %.1f -> %.1f px on them, %d spliced%s",
+                  ": %.1f px -> %.1f px fitted alone on them, %d spliced%s",
                   window_before / window_frames_above,
                   window_after / window_frames_above, window_spliced,
                   Seconds(std::chrono::duration<double>(
