@@ -179,10 +179,9 @@ struct FitOptions {
   // stage 4 are fitted again as a clip of their own, with this many frames
   // of context on each side, and spliced in where they explain the 2D
   // better (a window over half the clip is skipped); stages 2-4 then run
-  // again over the whole clip. A long clip's one
-  // start and smooth terms can hold a stretch in a wrong basin (the stealthy
-  // walk's side views: 37-131 frames at 18-25 px beside 0.7 px elsewhere).
-  // 0: off.
+  // again over the whole clip. A long clip's one start and smooth terms can
+  // hold a stretch in a wrong basin (the stealthy walk's side views:
+  // stretches of 25-131 frames at 17-25 px beside 0.7 px elsewhere). 0: off.
   double window_refit_residual_scale = 0.1;
   int window_refit_context_frames = 45;
   int num_threads = 1;
