@@ -138,6 +138,10 @@ FitAccuracy MeasureFitAccuracy(const ViewEstimate& estimate,
     accuracy.object_error_mm = 1000.0 * object_sum_m / num_objects;
   accuracy.pa_mpjpe_mm =
       1000.0 * ProcrustesAlignedError(fitted, truth.keypoints_m);
+  for (double error_m :
+       ProcrustesAlignedErrorPerKeypoint(fitted, truth.keypoints_m))
+    accuracy.pa_per_keypoint_mm.push_back(1000.0 * error_m);
+  accuracy.keypoint_names = truth.layout->keypoint_names;
   accuracy.reachable_pa_mpjpe_mm = 1000.0 * ReachableFloorM(truth, character);
 
   const FitSummary& summary = estimate.summary;
@@ -182,6 +186,19 @@ FitAccuracy MeanFitAccuracy(const std::vector<FitAccuracy>& accuracies) {
     ++with_objects;
   }
   if (with_objects > 0) mean.object_error_mm = object_sum_mm / with_objects;
+  // Per keypoint: the mean when every accuracy has the same keypoints.
+  mean.keypoint_names = accuracies.front().keypoint_names;
+  mean.pa_per_keypoint_mm.assign(mean.keypoint_names.size(), 0.0);
+  for (const FitAccuracy& a : accuracies) {
+    if (a.keypoint_names != mean.keypoint_names ||
+        a.pa_per_keypoint_mm.size() != mean.keypoint_names.size()) {
+      mean.keypoint_names.clear();
+      mean.pa_per_keypoint_mm.clear();
+      break;
+    }
+    for (size_t j = 0; j < a.pa_per_keypoint_mm.size(); ++j)
+      mean.pa_per_keypoint_mm[j] += a.pa_per_keypoint_mm[j] / n;
+  }
   mean.num_frames = static_cast<int>(std::lround(frames / n));
   return mean;
 }
@@ -202,12 +219,27 @@ std::string FitAccuracy::BriefReport() const {
     std::snprintf(line, sizeof(line), ", object %.0f mm", object_error_mm);
     report += line;
   }
+  const int worst = WorstKeypoint();
+  if (worst >= 0) {
+    std::snprintf(line, sizeof(line), ", worst keypoint %s (PA %.0f mm)",
+                  keypoint_names[worst].c_str(), pa_per_keypoint_mm[worst]);
+    report += line;
+  }
   if (cpu_seconds_per_100_frames > 0) {
     std::snprintf(line, sizeof(line), " (CPU %.1f s per 100 frames)",
                   cpu_seconds_per_100_frames);
     report += line;
   }
   return report;
+}
+
+int FitAccuracy::WorstKeypoint() const {
+  if (pa_per_keypoint_mm.empty() ||
+      pa_per_keypoint_mm.size() != keypoint_names.size())
+    return -1;
+  return static_cast<int>(
+      std::max_element(pa_per_keypoint_mm.begin(), pa_per_keypoint_mm.end()) -
+      pa_per_keypoint_mm.begin());
 }
 
 }  // namespace m2d

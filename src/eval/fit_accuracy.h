@@ -38,6 +38,12 @@ struct FitAccuracy {
   // clip may bend joints further than the simulated character can; the
   // fit holds its poses inside the ranges). 0 without true poses.
   double reachable_pa_mpjpe_mm = 0.0;
+  // PA-MPJPE per keypoint (mm, the truth's layout order) and those
+  // keypoints' names: a limb fitted in its depth-mirrored solution (it
+  // projects alike) shows as its end far above the rest, which the mean
+  // hides.
+  std::vector<double> pa_per_keypoint_mm;
+  std::vector<std::string> keypoint_names;
   // Objects (a ball): the fitted centre's offset from the character's root
   // against the truth's, after the root-relative error's rotation about z
   // (YawAlignedObjectError), mean over objects and frames, in millimetres;
@@ -56,6 +62,8 @@ struct FitAccuracy {
 
   // One line: camera errors, pose errors, reprojection, time.
   std::string BriefReport() const;
+  // The keypoint with the largest PA error; -1 without per-keypoint errors.
+  int WorstKeypoint() const;
 };
 
 // Measures `estimate` (one view's fit) against that view's true cameras (1

@@ -100,12 +100,13 @@ double YawAlignedObjectError(
   return sum / num_frames;
 }
 
-double ProcrustesAlignedError(const KeypointFrames& simulated,
-                              const KeypointFrames& truth) {
-  double sum = 0.0;
-  long count = 0;
-  for (size_t t = 0; t < simulated.size() && t < truth.size(); ++t) {
-    const long num_points = static_cast<long>(simulated[t].size());
+std::vector<double> ProcrustesAlignedErrorPerKeypoint(
+    const KeypointFrames& simulated, const KeypointFrames& truth) {
+  const size_t num_frames = std::min(simulated.size(), truth.size());
+  if (num_frames == 0) return {};
+  const long num_points = static_cast<long>(simulated[0].size());
+  std::vector<double> sums(num_points, 0.0);
+  for (size_t t = 0; t < num_frames; ++t) {
     Eigen::Matrix3Xd from(3, num_points), to(3, num_points);
     for (long j = 0; j < num_points; ++j) {
       from.col(j) = simulated[t][j];
@@ -115,10 +116,23 @@ double ProcrustesAlignedError(const KeypointFrames& simulated,
     const Eigen::Matrix3Xd aligned =
         (transform.topLeftCorner<3, 3>() * from).colwise() +
         transform.topRightCorner<3, 1>();
-    sum += (aligned - to).colwise().norm().sum();
-    count += num_points;
+    const Eigen::RowVectorXd distances = (aligned - to).colwise().norm();
+    for (long j = 0; j < num_points; ++j) sums[j] += distances[j];
   }
-  return count ? sum / count : 0.0;
+  for (double& sum : sums) sum /= static_cast<double>(num_frames);
+  return sums;
+}
+
+double ProcrustesAlignedError(const KeypointFrames& simulated,
+                              const KeypointFrames& truth) {
+  // Every frame holds every keypoint, so the mean of the per-keypoint means
+  // is the mean over all of them.
+  const std::vector<double> per_keypoint =
+      ProcrustesAlignedErrorPerKeypoint(simulated, truth);
+  if (per_keypoint.empty()) return 0.0;
+  double sum = 0.0;
+  for (double error : per_keypoint) sum += error;
+  return sum / static_cast<double>(per_keypoint.size());
 }
 
 double MeanJerk(const KeypointFrames& positions, double fps) {

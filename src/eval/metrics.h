@@ -49,6 +49,12 @@ double YawAlignedObjectError(
 // then the mean distance (metres): pose error alone.
 double ProcrustesAlignedError(const KeypointFrames& simulated,
                               const KeypointFrames& truth);
+// The same alignment, the mean distance per keypoint (metres, one entry per
+// keypoint of the first frame): which keypoints the pose error sits in (a
+// limb fitted in its depth-mirrored solution shows as one or two keypoints
+// far above the rest).
+std::vector<double> ProcrustesAlignedErrorPerKeypoint(
+    const KeypointFrames& simulated, const KeypointFrames& truth);
 
 // Jitter: mean over frames and keypoints of the magnitude of the third
 // time derivative of positions (finite differences at `fps`), in units of

@@ -8,7 +8,8 @@
 
 namespace m2d {
 
-RunningNormalizerImpl::RunningNormalizerImpl(int size) {
+RunningNormalizerImpl::RunningNormalizerImpl(int size, double clip_std)
+    : clip_std(clip_std) {
   mean = register_buffer("mean", torch::zeros({size}));
   variance = register_buffer("variance", torch::ones({size}));
   count = register_buffer("count", torch::full({1}, 1e-4));
@@ -30,7 +31,7 @@ void RunningNormalizerImpl::Update(const torch::Tensor& batch) {
 }
 
 torch::Tensor RunningNormalizerImpl::Normalize(const torch::Tensor& x) const {
-  return ((x - mean) / torch::sqrt(variance + 1e-8)).clamp(-5.0, 5.0);
+  return ((x - mean) / torch::sqrt(variance + 1e-8)).clamp(-clip_std, clip_std);
 }
 
 torch::nn::Sequential MakeMlp(int input, const std::vector<int>& hidden,
@@ -57,10 +58,12 @@ ActorCriticImpl::ActorCriticImpl(const ObservationLayout& layout,
     : layout_(layout),
       base_size_(layout.view_offset()),
       action_size_(action_size) {
-  base_normalizer =
-      register_module("base_normalizer", RunningNormalizer(base_size_));
-  view_normalizer =
-      register_module("view_normalizer", RunningNormalizer(layout.view_size()));
+  base_normalizer = register_module(
+      "base_normalizer",
+      RunningNormalizer(base_size_, options.observation_clip_std));
+  view_normalizer = register_module(
+      "view_normalizer",
+      RunningNormalizer(layout.view_size(), options.observation_clip_std));
   // phi ends in a ReLU so that averaging over views mixes features of the
   // same kind (non-negative activations), as in the paper's aggregation.
   auto make_encoder = [&]() {

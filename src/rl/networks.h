@@ -17,13 +17,16 @@ namespace m2d {
 
 // Running mean and variance of observation features (Chan et al.'s
 // parallel update), kept as buffers so they are saved with the model.
+// Normalized features are clipped to +-clip_std (a setting, not saved: the
+// config rebuilds it).
 class RunningNormalizerImpl : public torch::nn::Module {
  public:
-  explicit RunningNormalizerImpl(int size);
+  RunningNormalizerImpl(int size, double clip_std);
   void Update(const torch::Tensor& batch);                // [B, size]
-  torch::Tensor Normalize(const torch::Tensor& x) const;  // clipped to +-5
+  torch::Tensor Normalize(const torch::Tensor& x) const;  // clipped
 
   torch::Tensor mean, variance, count;
+  double clip_std;
 };
 TORCH_MODULE(RunningNormalizer);
 

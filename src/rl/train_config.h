@@ -53,6 +53,12 @@ struct ModelOptions {
   std::vector<int> critic_hidden = {512, 256, 256};
   double action_std = 0.1;        // Gaussian sigma, in normalized actions
   bool learn_action_std = false;  // fixed sigma, as MimicKit and PHC
+  // Normalized observation features are clipped to +-this many running
+  // standard deviations. 5 (Isaac Gym's and rl_games' value) blinds a policy
+  // trained on walks to the zombie walk's raised arms, 6-7 sigma out in its
+  // wrists' and upper arms' features (docs/training.md, "The normalizer's
+  // clip").
+  double observation_clip_std = 5.0;
 
   // Every setting (common/settings.h): the config's `model` section.
   template <typename Self, typename Visitor>
@@ -70,6 +76,9 @@ struct ModelOptions {
       "Gaussian sigma, in normalized action units");
     v("learn_action_std", self.learn_action_std, Range::Any(),
       "learn sigma instead of keeping it fixed");
+    v("observation_clip_std", self.observation_clip_std, Range::Above(0),
+      "normalized observation features are clipped to +-this (running "
+      "standard deviations)");
   }
   void Validate() const;
 };

@@ -163,6 +163,37 @@ TEST(MeasureFitAccuracy, PosesInAnotherHeadingAndPlaceHaveNoPoseError) {
   EXPECT_GT(bent_accuracy.pa_mpjpe_mm, 10.0);
 }
 
+// An arm fitted in another solution (the right shoulder turned 90 deg, the
+// arm raised forward where the truth's hangs) is named: its wrist is the
+// worst keypoint, which the mean PA-MPJPE does not say.
+TEST(MeasureFitAccuracy, AnArmFittedWrongIsNamedAsTheWorstKeypoint) {
+  auto character = Humanoid();
+  const ReferenceBundle bundle = WalkBundle(*character);
+  ViewEstimate estimate = TruthAsEstimate(bundle, *character);
+  const int shoulder = character->skeleton().IndexOf("right_shoulder");
+  ASSERT_GE(shoulder, 0);
+  for (Pose3D& pose : estimate.poses) {
+    pose.local_rotations[shoulder] = pose.local_rotations[shoulder] *
+                                     Eigen::Quaterniond(Eigen::AngleAxisd(
+                                         -90 * kDeg, Eigen::Vector3d::UnitY()));
+  }
+  const FitAccuracy accuracy = MeasureFitAccuracy(
+      estimate, bundle.views[0].cameras, *bundle.ground_truth, *character);
+  ASSERT_EQ(accuracy.pa_per_keypoint_mm.size(), 17u);
+  ASSERT_GE(accuracy.WorstKeypoint(), 0);
+  EXPECT_EQ(accuracy.keypoint_names[accuracy.WorstKeypoint()], "right_wrist");
+  EXPECT_GT(accuracy.pa_per_keypoint_mm[accuracy.WorstKeypoint()],
+            3.0 * accuracy.pa_mpjpe_mm);
+  EXPECT_NE(accuracy.BriefReport().find("worst keypoint right_wrist"),
+            std::string::npos)
+      << accuracy.BriefReport();
+  // Averaged over views keypoint by keypoint.
+  const FitAccuracy mean = MeanFitAccuracy({accuracy, accuracy});
+  ASSERT_EQ(mean.pa_per_keypoint_mm.size(), 17u);
+  EXPECT_NEAR(mean.pa_per_keypoint_mm[accuracy.WorstKeypoint()],
+              accuracy.pa_per_keypoint_mm[accuracy.WorstKeypoint()], 1e-9);
+}
+
 // A truth bent past the character's joint ranges (a left hip raised 100 deg
 // sideways, as the DeepMimic kick does about 60 deg past the range) cannot
 // be fitted exactly: the reachable floor says how far it is.

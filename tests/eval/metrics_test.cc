@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -265,6 +266,28 @@ TEST(ProcrustesAlignedError, APoseErrorRemains) {
                   Transformed(simulated, Yaw(1.0), 0.7, {1, 2, 3}), truth),
               error, 1e-9);
   EXPECT_EQ(ProcrustesAlignedError({}, truth), 0.0);
+}
+
+TEST(ProcrustesAlignedError,
+     PerKeypointPointsAtTheKeypointOffAndAveragesToTheMean) {
+  const KeypointFrames truth = MakePoses(4);
+  KeypointFrames simulated = truth;
+  for (auto& frame : simulated) frame[9].x() += 0.3;  // a wrist 30 cm off
+  const std::vector<double> per_keypoint =
+      ProcrustesAlignedErrorPerKeypoint(simulated, truth);
+  ASSERT_EQ(per_keypoint.size(), truth[0].size());
+  const auto worst = std::max_element(per_keypoint.begin(), per_keypoint.end());
+  EXPECT_EQ(worst - per_keypoint.begin(), 9);
+  // The alignment spreads a little of it over the others; most stays there.
+  for (size_t j = 0; j < per_keypoint.size(); ++j) {
+    if (j == 9) continue;
+    EXPECT_LT(per_keypoint[j], 0.5 * *worst) << j;
+  }
+  double sum = 0.0;
+  for (double error : per_keypoint) sum += error;
+  EXPECT_NEAR(sum / per_keypoint.size(),
+              ProcrustesAlignedError(simulated, truth), 1e-12);
+  EXPECT_TRUE(ProcrustesAlignedErrorPerKeypoint({}, truth).empty());
 }
 
 EvalRow Row(const std::string& view, int episodes, double succ, double e2d_px,

@@ -137,7 +137,7 @@ TEST(Networks, ABf16ScopeRoundsOnlyWithinItAndStaysNearFloat32) {
 }
 
 TEST(Networks, RunningNormalizerTracksMeanAndVariance) {
-  RunningNormalizer normalizer(2);
+  RunningNormalizer normalizer(2, /*clip_std=*/5.0);
   torch::manual_seed(1);
   for (int i = 0; i < 20; ++i) {
     torch::Tensor batch = torch::randn({500, 2}) * torch::tensor({2.0f, 0.5f}) +
@@ -148,6 +148,31 @@ TEST(Networks, RunningNormalizerTracksMeanAndVariance) {
   EXPECT_NEAR(normalizer->mean[1].item<float>(), -1.0f, 0.02f);
   EXPECT_NEAR(normalizer->variance[0].item<float>(), 4.0f, 0.2f);
   EXPECT_NEAR(normalizer->variance[1].item<float>(), 0.25f, 0.02f);
+}
+
+TEST(Networks, NormalizedFeaturesAreClippedAtTheConfiguredDeviations) {
+  // A feature 7 running standard deviations out (the zombie walk's raised
+  // wrists under a walks-trained normalizer) reaches the networks as 5 under
+  // the default clip, as itself under a clip of 10.
+  ObservationLayout layout = SmallLayout();
+  torch::manual_seed(3);
+  torch::Tensor batch = torch::randn({2000, layout.size()});
+  for (double clip : {5.0, 10.0}) {
+    ModelOptions options;
+    options.observation_clip_std = clip;
+    ActorCritic model(layout, options, 2);
+    model->UpdateNormalizer(batch);
+    const torch::Tensor normalizer_mean = batch.mean(0);
+    const torch::Tensor normalizer_std = batch.std(0, /*unbiased=*/false);
+    torch::Tensor far = (normalizer_mean + 7.0 * normalizer_std).unsqueeze(0);
+    torch::Tensor normalized = model->Normalize(far);
+    EXPECT_NEAR(normalized.min().item<float>(), std::min(clip, 7.0), 1e-3)
+        << "clip " << clip;
+    EXPECT_NEAR(normalized.max().item<float>(), std::min(clip, 7.0), 1e-3)
+        << "clip " << clip;
+  }
+  ModelOptions defaults;
+  EXPECT_EQ(defaults.observation_clip_std, 5.0);
 }
 
 TEST(Networks, LogProbMatchesTheGaussianDensity) {
