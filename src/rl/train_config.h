@@ -54,10 +54,10 @@ struct ModelOptions {
   double action_std = 0.1;        // Gaussian sigma, in normalized actions
   bool learn_action_std = false;  // fixed sigma, as MimicKit and PHC
   // Normalized observation features are clipped to +-this many running
-  // standard deviations. 5 (Isaac Gym's and rl_games' value) blinds a policy
-  // trained on walks to the zombie walk's raised arms, 6-7 sigma out in its
-  // wrists' and upper arms' features (docs/training.md, "The normalizer's
-  // clip").
+  // standard deviations (5: Isaac Gym's and rl_games' value). Under a walks'
+  // normalizer the zombie walk's wrists and upper arms sit 6-7 sigma out, at
+  // the clip; 10 did not make it learn faster (docs/training.md, "The
+  // normalizer's clip").
   double observation_clip_std = 5.0;
 
   // Every setting (common/settings.h): the config's `model` section.
