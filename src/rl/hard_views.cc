@@ -21,9 +21,28 @@ double FullRolloutFailure(const ViewFailureRecord& record, int num_frames) {
   return 1.0 - std::exp(-hazard_per_step * std::max(num_frames - 1, 1));
 }
 
+double HazardPerEpisodeStep(const ViewFailureRecord& record) {
+  if (record.steps <= 0.0 || record.episodes <= 0.0) return -1.0;
+  return FailureHazard(record) * record.episodes / record.steps;
+}
+
 namespace {
 
-// Each view's FullRolloutFailure (negative: no episodes yet), and how many
+// A view's value of `measure`; negative when unknown (no episodes yet).
+double StartMeasure(const ViewFailureRecord& record, int num_frames,
+                    HardViewMeasure measure) {
+  switch (measure) {
+    case HardViewMeasure::kFullRollout:
+      return FullRolloutFailure(record, num_frames);
+    case HardViewMeasure::kHazard:
+      return FailureHazard(record);
+    case HardViewMeasure::kHazardSamples:
+      return HazardPerEpisodeStep(record);
+  }
+  return -1.0;
+}
+
+// Each view's `measure` (negative: no episodes yet), and how many
 // views have episodes, with the mean of their chances.
 struct FailureChances {
   std::vector<double> per_view;
@@ -38,9 +57,7 @@ FailureChances ChancesOf(const std::vector<ViewFailureRecord>& records,
   double known_sum = 0.0;
   for (size_t v = 0; v < records.size(); ++v) {
     chances.per_view.push_back(
-        measure == HardViewMeasure::kHazard
-            ? FailureHazard(records[v])
-            : FullRolloutFailure(records[v], num_frames[v]));
+        StartMeasure(records[v], num_frames[v], measure));
     if (chances.per_view.back() < 0.0) continue;
     known_sum += chances.per_view.back();
     ++chances.known;

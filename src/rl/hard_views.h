@@ -35,8 +35,14 @@ double FullRolloutFailure(const ViewFailureRecord& record, int num_frames);
 // record holds no steps (unknown).
 double FailureHazard(const ViewFailureRecord& record);
 
+// The hazard over the mean episode length (steps per episode ended): starts
+// in proportion to it give each view samples (starts x steps per episode)
+// in proportion to its hazard. Negative when the record holds no episodes.
+double HazardPerEpisodeStep(const ViewFailureRecord& record);
+
 // Start weights per view, summing to 1: a `share` in proportion to each
-// view's `measure` (FullRolloutFailure or FailureHazard; an unknown view
+// view's `measure` (FullRolloutFailure, FailureHazard or
+// HazardPerEpisodeStep; an unknown view
 // counts as the known views' mean), the rest uniform. Uniform when no view
 // is known to fail.
 std::vector<double> HardViewWeights(

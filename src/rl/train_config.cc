@@ -94,12 +94,23 @@ bool ParseSetting(const std::string& text, CollectionMode* mode) {
 }
 
 const char* SettingName(HardViewMeasure measure) {
-  return measure == HardViewMeasure::kHazard ? "hazard" : "full_rollout";
+  switch (measure) {
+    case HardViewMeasure::kFullRollout:
+      return "full_rollout";
+    case HardViewMeasure::kHazard:
+      return "hazard";
+    case HardViewMeasure::kHazardSamples:
+      return "hazard_samples";
+  }
+  return "?";
 }
 
 bool ParseSetting(const std::string& text, HardViewMeasure* measure) {
   return ParseSettingByName(
-      text, {HardViewMeasure::kFullRollout, HardViewMeasure::kHazard}, measure);
+      text,
+      {HardViewMeasure::kFullRollout, HardViewMeasure::kHazard,
+       HardViewMeasure::kHazardSamples},
+      measure);
 }
 
 void ModelOptions::Validate() const {

@@ -163,11 +163,16 @@ enum class HardViewMeasure {
   // episodes end (a clip lost in 11 frames otherwise gets 1/20 of the
   // samples of one held for 200).
   kHazard,
+  // The hazard over the view's mean episode length (steps): starts in
+  // proportion to it give every view samples in proportion to its hazard,
+  // so a view lost in 25 frames gets 6x the samples of one lost in 150
+  // (kHazard: the same), while ~1/25 of their starts are its episodes.
+  kHazardSamples,
 };
 const char* SettingName(HardViewMeasure measure);
 bool ParseSetting(const std::string& text, HardViewMeasure* measure);
 inline std::string SettingChoices(HardViewMeasure) {
-  return "full_rollout, hazard";
+  return "full_rollout, hazard, hazard_samples";
 }
 
 // PPO (CleanRL-style "agent" config). Every field is documented in
@@ -334,8 +339,10 @@ struct AsiOptions {
       "half life (samples) of the failure records hard-view sampling reads");
     v("hard_view_measure", self.hard_view_measure, Range::Any(),
       "what hard-view starts are in proportion to: full_rollout (a view's "
-      "chance of failing a whole rollout) or hazard (its early exits per "
-      "step: every failing view gets about the same samples)");
+      "chance of failing a whole rollout), hazard (its early exits per "
+      "step: every failing view gets about the same samples) or "
+      "hazard_samples (the hazard over its mean episode length: samples in "
+      "proportion to the hazard)");
   }
   void Validate() const;
 };

@@ -74,6 +74,28 @@ TEST(HardViews, HazardWeightsGiveFailingViewsEqualSamples) {
   EXPECT_NEAR(hazard[3] / hazard[0], known_mean / 0.1, 1e-12);
 }
 
+TEST(HardViews, HazardSampleWeightsGiveFailingViewsSamplesInProportion) {
+  EXPECT_LT(HazardPerEpisodeStep({}), 0.0);  // no episodes: unknown
+  // Views lost after 10 and after 200 steps, one held (2 episodes to the
+  // end, never lost): by hazard both failing views get the same samples;
+  // by hazard over episode length the quick failure gets 20x the samples
+  // (its hazard is 20x), so 400x the starts.
+  const std::vector<int> frames = {2000, 2000, 2000};
+  const std::vector<ViewFailureRecord> records = {
+      {1000, 100, 100}, {1000, 5, 5}, {1000, 0, 2}};
+  const std::vector<double> weights =
+      HardViewWeights(records, frames, 1.0, HardViewMeasure::kHazardSamples);
+  EXPECT_NEAR(std::accumulate(weights.begin(), weights.end(), 0.0), 1.0, 1e-12);
+  const double samples_quick = weights[0] * 10.0;
+  const double samples_slow = weights[1] * 200.0;
+  EXPECT_NEAR(samples_quick / samples_slow, 0.1 / 0.005, 1e-9);
+  EXPECT_DOUBLE_EQ(weights[2], 0.0);
+  // A uniform part stays whatever the measure.
+  const std::vector<double> shared =
+      HardViewWeights(records, frames, 0.8, HardViewMeasure::kHazardSamples);
+  EXPECT_NEAR(shared[2], 0.2 / 3.0, 1e-12);
+}
+
 TEST(HardViews, TheHazardSamplerListsViewsByStartWeight) {
   TrackingTask task = testing::MakeGlidingTask(/*num_views=*/2);
   HardViewSampler sampler(*task.reference, /*share=*/1.0,
