@@ -166,7 +166,7 @@ enum class HardViewMeasure {
   // The hazard over the view's mean episode length (steps): starts in
   // proportion to it give every view samples in proportion to its hazard,
   // so a view lost in 25 frames gets 6x the samples of one lost in 150
-  // (kHazard: the same), while ~1/25 of their starts are its episodes.
+  // (kHazard: the same samples).
   kHazardSamples,
 };
 const char* SettingName(HardViewMeasure measure);
