@@ -42,9 +42,8 @@ double HazardPerEpisodeStep(const ViewFailureRecord& record);
 
 // Start weights per view, summing to 1: a `share` in proportion to each
 // view's `measure` (FullRolloutFailure, FailureHazard or
-// HazardPerEpisodeStep; an unknown view
-// counts as the known views' mean), the rest uniform. Uniform when no view
-// is known to fail.
+// HazardPerEpisodeStep; an unknown view counts as the known views' mean),
+// the rest uniform. Uniform when no view is known to fail.
 std::vector<double> HardViewWeights(
     const std::vector<ViewFailureRecord>& records,
     const std::vector<int>& num_frames, double share,
