@@ -7,19 +7,27 @@
 #   2. the training walks themselves (runs/walks, the fits' starts and
 #      cameras, 2 rollouts of 10 s per view), per walk.
 # No 3D truth is read by either.
-#   [FIT_CONFIG=configs/fit/root_dolly.yaml] \
+#   [FIT_CONFIG=configs/fit/root_dolly.yaml] [DRAWS=N] \
 #     docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
 # FIT_CONFIG: the FitOptions of the streams' start fits (default: the
 # defaults, as every figure before 2026-12-05 was measured).
+# DRAWS: how many draws of the 18 streams (default 1: seeds 1-9, as every
+# figure before 2026-12-06's sixth session; draw d uses seeds 9d+1...9d+9,
+# logged as OUT_PREFIX_generated[_d].log). One draw moves the count by 2-3.
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 checkpoint=$1 out=$2
 fit_config=()
 [ -n "${FIT_CONFIG:-}" ] && fit_config=(--fit-config "$FIT_CONFIG")
-build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
-  "${fit_config[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
-  -o "${out}_generated.json" > "${out}_generated.log" 2>&1
-grep -E "generation|^Succ" "${out}_generated.log"
+for ((draw = 0; draw < ${DRAWS:-1}; ++draw)); do
+  suffix=""
+  [ "$draw" -gt 0 ] && suffix="_$draw"
+  build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
+    "${fit_config[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
+    --seed $((9 * draw + 1)) -o "${out}_generated${suffix}.json" \
+    > "${out}_generated${suffix}.log" 2>&1
+  grep -E "generation|^Succ" "${out}_generated${suffix}.log"
+done
 build/mimic2d eval "$checkpoint" --episodes 2 --episode-s 10 \
   -o "${out}_eval.json" > "${out}_eval.log" 2>&1
 tail -n 45 "${out}_eval.log"
