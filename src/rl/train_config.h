@@ -238,7 +238,8 @@ struct PpoOptions {
     v("minibatch_size", self.minibatch_size, Range::AtLeast(1),
       "samples per gradient step (at most the batch)");
     v("learning_rate", self.learning_rate, Range::Above(0),
-      "Adam's rate; with target_kl > 0 the first iteration's");
+      "Adam's rate; with target_kl > 0 the first iteration's (with "
+      "run.init_from: the source's rate, within the bounds)");
     v("target_kl", self.target_kl, Range::AtLeast(0),
       "> 0: adapt the rate toward this KL per update (rl_games rule); 0: "
       "fixed rate");
@@ -382,8 +383,8 @@ struct RunOptions {
     v("init_from", self.init_from, Range::Any(),
       "a fresh run starts from this checkpoint's networks and observation "
       "normalizer (same character, observation and network sizes); the "
-      "optimizer, initial-state buffers and counters start fresh; empty: "
-      "random weights");
+      "optimizer, initial-state buffers and counters start fresh, an "
+      "adaptive rate at the source's; empty: random weights");
   }
   void Validate() const;
 };

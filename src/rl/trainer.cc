@@ -136,13 +136,14 @@ struct Trainer::State {
   // Fine-tuning: the networks and normalizer of `path` (InputError naming it
   // when its networks do not fit this config); the fixed sigma stays the
   // config's. Optimizer, buffers and counters stay fresh.
-  void InitializeNetworksFrom(const std::string& path) {
+  CheckpointCounters InitializeNetworksFrom(const std::string& path) {
     const CheckpointCounters from =
         LoadCheckpoint(path, model, /*optimizer=*/nullptr,
                        /*initial_states=*/nullptr, state_template);
     ApplyConfiguredActionStd();
     spdlog::info("networks initialized from {} ({} samples of training there)",
                  path, from.samples);
+    return from;
   }
 };
 
@@ -263,7 +264,20 @@ Trainer::Trainer(const TrainConfig& config, bool resume) : state_(new State) {
     if (resume)
       spdlog::warn("--resume: no checkpoint at {}; starting fresh",
                    s.checkpoint_path);
-    if (!run.init_from.empty()) s.InitializeNetworksFrom(run.init_from);
+    if (!run.init_from.empty()) {
+      const CheckpointCounters from = s.InitializeNetworksFrom(run.init_from);
+      // An adaptive rate continues at the source's (within this config's
+      // bounds): a fresh Adam's first steps move every weight by about the
+      // rate: the walk-family fine-tunes (2e-4, their sources at the 3e-5
+      // floor) took a first update of KL 9-165 (docs/training.md).
+      if (config.ppo.target_kl > 0 && from.learning_rate > 0) {
+        s.SetLearningRate(std::clamp(from.learning_rate,
+                                     config.ppo.learning_rate_min,
+                                     config.ppo.learning_rate_max));
+        spdlog::info("adaptive learning rate starts at {} (the source's)",
+                     s.LearningRate());
+      }
+    }
     TrainingLog::Start(s.log_path);
   }
   // The action noise shares the update's stream, unless the two run at

@@ -337,6 +337,7 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   M2D_REQUIRE_SHARED(walk_path, kWalk);
   const std::string dir = testing::TempDir("resume_init_from");
   TrainConfig config = TinyConfig(walk_path, dir);
+  config.ppo.learning_rate = 7e-5;  // the source's rate, fixed
   RunResult first = TrainIterations(config, /*resume=*/false, 2);
   const std::string pretrained = first.summary.checkpoint_path;
 
@@ -373,6 +374,26 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   ActorCritic c = ReadModel(unrelated.run.run_dir + "/checkpoint.pt", &started);
   EXPECT_FALSE(torch::equal(a->named_parameters()["actor.0.weight"],
                             c->named_parameters()["actor.0.weight"]));
+
+  // A fixed rate is the config's; an adaptive one starts at the source's,
+  // within the config's bounds.
+  EXPECT_DOUBLE_EQ(from.learning_rate, 7e-5);
+  EXPECT_DOUBLE_EQ(started.learning_rate, tuned.ppo.learning_rate);
+  const auto starting_rate = [&](const std::string& name, double min_rate) {
+    TrainConfig adaptive = tuned;
+    adaptive.run.run_dir = dir + "/" + name;
+    adaptive.ppo.target_kl = 0.01;
+    adaptive.ppo.learning_rate_min = min_rate;
+    {
+      Trainer trainer(adaptive, /*resume=*/false);
+      trainer.SaveCheckpoint();
+    }
+    CheckpointCounters counters;
+    ReadModel(adaptive.run.run_dir + "/checkpoint.pt", &counters);
+    return counters.learning_rate;
+  };
+  EXPECT_DOUBLE_EQ(starting_rate("adaptive", 1e-6), 7e-5);
+  EXPECT_DOUBLE_EQ(starting_rate("adaptive_floor", 1e-4), 1e-4);
 
   // Networks of other sizes: an error naming the checkpoint.
   TrainConfig other_sizes = tuned;
