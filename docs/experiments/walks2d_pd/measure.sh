@@ -7,23 +7,29 @@
 #   2. the training walks themselves (runs/walks, the fits' starts and
 #      cameras, 2 rollouts of 10 s per view), per walk.
 # No 3D truth is read by either.
-#   [FIT_CONFIG=configs/fit/root_dolly.yaml] [DRAWS=N] \
-#     docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
+#   [FIT_CONFIG=configs/fit/root_dolly.yaml] [DRAWS=N] [START_FIT_S=s] \
+#     [START_AT_S=s] docs/experiments/walks2d_pd/measure.sh CHECKPOINT OUT_PREFIX
 # FIT_CONFIG: the FitOptions of the streams' start fits (default: the
 # defaults, as every figure before 2026-12-05 was measured).
 # DRAWS: how many draws of the 18 streams (default 1: seeds 1-9, as every
 # figure before 2026-12-06's sixth session; draw d uses seeds 9d+1...9d+9,
 # logged as OUT_PREFIX_generated[_d].log). One draw moves the count by 2-3.
+# START_FIT_S, START_AT_S: generate's --start-fit-s (the stream's first
+# seconds fitted, default 2) and --start-at-s (where the rollout starts,
+# default the middle of the fitted seconds); figures before 2026-12-07 are
+# of the defaults.
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 checkpoint=$1 out=$2
-fit_config=()
-[ -n "${FIT_CONFIG:-}" ] && fit_config=(--fit-config "$FIT_CONFIG")
+start_options=()
+[ -n "${FIT_CONFIG:-}" ] && start_options=(--fit-config "$FIT_CONFIG")
+[ -n "${START_FIT_S:-}" ] && start_options+=(--start-fit-s "$START_FIT_S")
+[ -n "${START_AT_S:-}" ] && start_options+=(--start-at-s "$START_AT_S")
 for ((draw = 0; draw < ${DRAWS:-1}; ++draw)); do
   suffix=""
   [ "$draw" -gt 0 ] && suffix="_$draw"
   build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
-    "${fit_config[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
+    "${start_options[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
     --seed $((9 * draw + 1)) -o "${out}_generated${suffix}.json" \
     > "${out}_generated${suffix}.log" 2>&1
   grep -E "generation|^Succ" "${out}_generated${suffix}.log"
