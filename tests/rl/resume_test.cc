@@ -345,6 +345,7 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   tuned.run.run_dir = dir + "/tuned";
   tuned.run.seed = 9;
   tuned.run.init_from = pretrained;
+  tuned.ppo.learning_rate = 2e-4;  // not the source's
   {
     Trainer trainer(tuned, /*resume=*/false);
     trainer.SaveCheckpoint();
@@ -355,6 +356,9 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   EXPECT_EQ(from.iteration, 2);
   EXPECT_EQ(started.iteration, 0);
   EXPECT_EQ(started.samples, 0);
+  // A fixed rate is the config's, not the source's.
+  EXPECT_DOUBLE_EQ(from.learning_rate, 7e-5);
+  EXPECT_DOUBLE_EQ(started.learning_rate, 2e-4);
   const auto a_state = a->named_parameters(), b_state = b->named_parameters();
   for (const auto& item : a_state)
     EXPECT_TRUE(torch::equal(item.value(), b_state[item.key()])) << item.key();
@@ -375,10 +379,7 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   EXPECT_FALSE(torch::equal(a->named_parameters()["actor.0.weight"],
                             c->named_parameters()["actor.0.weight"]));
 
-  // A fixed rate is the config's; an adaptive one starts at the source's,
-  // within the config's bounds.
-  EXPECT_DOUBLE_EQ(from.learning_rate, 7e-5);
-  EXPECT_DOUBLE_EQ(started.learning_rate, tuned.ppo.learning_rate);
+  // An adaptive rate starts at the source's, within the config's bounds.
   const auto starting_rate = [&](const std::string& name, double min_rate) {
     TrainConfig adaptive = tuned;
     adaptive.run.run_dir = dir + "/" + name;
