@@ -122,11 +122,15 @@ void AddEvalCommand(CLI::App& app, CommandRun* run) {
       ->check(CLI::IsMember({"truth", "estimate"}));
   eval->add_option("--camera", args->camera,
                    "The episodes' camera: recorded (each frame's as the "
-                   "cameras source has it) or follows_character (moved "
+                   "cameras source has it), follows_character (moved "
                    "with the simulated root's offset from the initial "
-                   "states' root; default: the checkpoint's env.camera)")
+                   "states' root) or dollies_from_start (the start "
+                   "frame's follows_character camera, then moved with the "
+                   "simulated root alone: generate --policy's camera); "
+                   "default: the checkpoint's env.camera")
       ->check(CLI::IsMember({SettingName(EpisodeCamera::kRecorded),
-                             SettingName(EpisodeCamera::kFollowsCharacter)}));
+                             SettingName(EpisodeCamera::kFollowsCharacter),
+                             SettingName(EpisodeCamera::kDolliesFromStart)}));
   eval->add_flag("--asi-starts", args->asi_starts,
                  "Start episodes from the checkpoint's ASI buffers (the "
                  "starts as training refined them) instead of fresh ones; "

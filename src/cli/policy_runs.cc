@@ -222,6 +222,12 @@ void PrintEvalTable(const CheckpointEvaluation& evaluation) {
         "the cameras follow the character: each frame's camera moved with "
         "the simulated root's offset from the initial states' motion's root "
         "(env.camera follows_character)\n");
+  } else if (evaluation.camera == EpisodeCamera::kDolliesFromStart) {
+    std::printf(
+        "the cameras dolly from the start: the start frame's camera moved "
+        "with the simulated root's offset from the initial states' root "
+        "there, held so for the episode (env.camera dollies_from_start, "
+        "generate --policy's)\n");
   }
   if (evaluation.sources.cameras == CameraSource::kEstimate) {
     std::printf(

@@ -84,13 +84,14 @@ TrackingEnv::TrackingEnv(std::shared_ptr<const Character> character,
           "or estimate, not default");
     }
   }
-  if (options_.camera == EpisodeCamera::kFollowsCharacter &&
+  if (options_.camera != EpisodeCamera::kRecorded &&
       (initial_states_ == nullptr ||
        reference_->sources().initial_states == InitialStateSource::kDefault)) {
     // The camera follows the character relative to a motion's root.
-    throw ConfigError(
-        "env: camera follows_character needs the motion the initial states "
-        "come from: initial_states truth or estimate, not default");
+    throw ConfigError(std::string("env: camera ") +
+                      SettingName(options_.camera) +
+                      " needs the motion the initial states come from: "
+                      "initial_states truth or estimate, not default");
   }
   if (options_.object_start_square_m > 0 &&
       reference_->num_object_points() == 0) {
@@ -361,10 +362,15 @@ PinholeCamera CameraFollowingCharacter(
 }
 
 void TrackingEnv::PlaceCameras() {
+  // The frame whose camera (and reference root) the episode's camera is
+  // placed from: the current one, or the start's for a rigid dolly.
+  const int camera_frame = options_.camera == EpisodeCamera::kDolliesFromStart
+                               ? episode_.start_frame
+                               : frame_;
   for (int k = 0; k < num_observed_views_; ++k) {
     const TrackedView& view = *observed_views_[k];
-    cameras_[k] =
-        reference_->bundles()[view.bundle].views[view.view].CameraAt(frame_);
+    cameras_[k] = reference_->bundles()[view.bundle].views[view.view].CameraAt(
+        camera_frame);
   }
   if (options_.camera == EpisodeCamera::kRecorded) return;
   // One offset for every view: the observed views of an episode share the
@@ -374,7 +380,7 @@ void TrackingEnv::PlaceCameras() {
   const Eigen::Vector3d simulated_root_m(root_qpos[0], root_qpos[1],
                                          root_qpos[2]);
   const Eigen::Vector3d& reference_root_m =
-      ReferenceBody(frame_).root_position_m;
+      ReferenceBody(camera_frame).root_position_m;
   for (PinholeCamera& camera : cameras_) {
     camera =
         CameraFollowingCharacter(camera, reference_root_m, simulated_root_m);

@@ -52,17 +52,33 @@ enum class EpisodeCamera {
   // but not its path over the ground. The rollouts of `generate --policy`
   // see the character so.
   kFollowsCharacter,
+  // The episode's start frame's kFollowsCharacter camera, then moved only
+  // with the simulated root (horizontally): the camera of `generate
+  // --policy`'s rollouts, which know one fitted camera, the start's, and
+  // dolly it with the character; the per-frame fitted cameras' turns and
+  // tilts are not followed.
+  kDolliesFromStart,
 };
 inline const char* SettingName(EpisodeCamera camera) {
-  return camera == EpisodeCamera::kRecorded ? "recorded" : "follows_character";
+  switch (camera) {
+    case EpisodeCamera::kRecorded:
+      return "recorded";
+    case EpisodeCamera::kFollowsCharacter:
+      return "follows_character";
+    case EpisodeCamera::kDolliesFromStart:
+      return "dollies_from_start";
+  }
+  return "?";
 }
 inline bool ParseSetting(const std::string& text, EpisodeCamera* camera) {
   return ParseSettingByName(
-      text, {EpisodeCamera::kRecorded, EpisodeCamera::kFollowsCharacter},
+      text,
+      {EpisodeCamera::kRecorded, EpisodeCamera::kFollowsCharacter,
+       EpisodeCamera::kDolliesFromStart},
       camera);
 }
 inline std::string SettingChoices(EpisodeCamera) {
-  return "recorded, follows_character";
+  return "recorded, follows_character, dollies_from_start";
 }
 
 // `recorded` moved horizontally by the offset of `simulated_root_m` from
@@ -189,8 +205,10 @@ struct TrackingEnvOptions {
       "or follows_character (that camera moved horizontally by the "
       "simulated root's offset from the initial states' motion's root at "
       "the frame: a camera dollying with the character, for following "
-      "views, whose 2D holds no path over the ground; needs initial_states "
-      "truth or estimate)");
+      "views, whose 2D holds no path over the ground) or dollies_from_start "
+      "(the start frame's follows_character camera, then moved with the "
+      "simulated root alone: generate --policy's camera); the last two "
+      "need initial_states truth or estimate");
     v("object_start_square_m", self.object_start_square_m, Range::AtLeast(0),
       "each episode's tracked objects (the ball) start moved on the floor "
       "uniformly within a square of this side (m) about their start; 0: "

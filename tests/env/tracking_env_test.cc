@@ -626,5 +626,60 @@ TEST(TrackingEnv, AFollowingCameraSeesADisplacedCharacterAsIfItWereNot) {
                ConfigError);
 }
 
+// A camera that dollies from the start (generate --policy's) is the
+// following camera at the start frame and from there moves with the
+// simulated root alone: the following camera keeps each frame's offset from
+// the reference's root (here gliding on under static cameras), the dolly
+// keeps the start frame's.
+TEST(TrackingEnv, ADollyFromStartKeepsTheStartFramesCameraAndMovesWithTheRoot) {
+  TrackingTask task = testing::MakeGlidingTask(/*num_views=*/1, 2.0);
+  TrackingEnvOptions following_options;
+  following_options.early_exit = false;  // the frames are compared, not judged
+  following_options.camera = EpisodeCamera::kFollowsCharacter;
+  TrackingEnvOptions dolly_options = following_options;
+  dolly_options.camera = EpisodeCamera::kDolliesFromStart;
+  TrackingEnv following(task.character, task.reference, task.initial_states,
+                        following_options, 1);
+  TrackingEnv dolly(task.character, task.reference, task.initial_states,
+                    dolly_options, 1);
+  const int start_frame = 5;
+  const int root = task.character->root_qpos_address();
+  auto reference_root = [&](int frame) {
+    const SimState& state = *task.initial_states->buffer(0).anchor(frame);
+    return Eigen::Vector3d(state.qpos[root], state.qpos[root + 1], 0.0);
+  };
+  SimState start = *task.initial_states->buffer(0).anchor(start_frame);
+  start.qpos[root] += 0.2;  // a start off the reference's root
+  std::vector<float> a(following.observation_size()),
+      b(dolly.observation_size());
+  following.ResetTo(0, start_frame, start, a.data());
+  dolly.ResetTo(0, start_frame, start, b.data());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(b[i], a[i]) << i;
+  const PinholeCamera start_camera = dolly.camera();
+
+  std::vector<float> action(following.action_size(), 0.0f);
+  for (int step = 1; step <= 15; ++step) {
+    // The same actions from the same state: one simulation, two cameras.
+    following.Step(action.data(), a.data());
+    dolly.Step(action.data(), b.data());
+    const Eigen::Vector3d glided_m =
+        reference_root(start_frame + step) - reference_root(start_frame);
+    EXPECT_LT((dolly.camera().CenterWorld() - following.camera().CenterWorld() -
+               glided_m)
+                  .norm(),
+              1e-9)
+        << step;
+    EXPECT_EQ(dolly.camera().rotation_world_to_camera(),
+              start_camera.rotation_world_to_camera());
+  }
+  // 0.5 m/s for 0.5 s: the two views differ by a quarter metre.
+  EXPECT_NEAR(
+      (dolly.camera().CenterWorld() - following.camera().CenterWorld()).norm(),
+      0.25, 0.01);
+  EXPECT_THROW(
+      TrackingEnv(task.character, task.reference, nullptr, dolly_options, 1),
+      ConfigError);
+}
+
 }  // namespace
 }  // namespace m2d
