@@ -31,6 +31,7 @@ struct FitArgs {
   // bundle): each view's fit is measured against it after fitting. The fit
   // never reads it.
   std::string truth;
+  std::vector<double> tilt_deg;  // --tilt: pitch, roll (deg); empty: fitted
   FitOptions options;
   bool quiet = false;
   bool rig = false;  // the views are one synchronized take (FitRig)
@@ -51,6 +52,11 @@ int RunFit(FitArgs& args) {
                       "'");
   }
   if (args.focal_px > 0) args.options.fixed_focal_px = args.focal_px;
+  if (!args.tilt_deg.empty()) {
+    args.options.tilt_known = true;
+    args.options.known_pitch_deg = args.tilt_deg[0];
+    args.options.known_roll_deg = args.tilt_deg[1];
+  }
   if (args.threads > 0) args.options.num_threads = args.threads;
   if (!args.quiet) {
     args.options.progress = [](const std::string& line) {
@@ -67,11 +73,14 @@ int RunFit(FitArgs& args) {
   const std::string character_path = AssetArgumentPath(args.character);
   auto character =
       LoadCharacterForSimulation(character_path, "flat", SimulationOptions());
-  std::printf("fitting %zu view(s) of %s (%d frames)%s, camera %s, focal %s\n",
-              bundle.views.size(), args.input.c_str(), bundle.num_frames(),
-              args.rig ? " as one rig" : "",
-              CameraMotionName(args.options.camera_motion),
-              args.options.fixed_focal_px > 0 ? "fixed" : "estimated");
+  std::printf(
+      "fitting %zu view(s) of %s (%d frames)%s, camera %s, focal %s, tilt "
+      "%s\n",
+      bundle.views.size(), args.input.c_str(), bundle.num_frames(),
+      args.rig ? " as one rig" : "",
+      CameraMotionName(args.options.camera_motion),
+      args.options.fixed_focal_px > 0 ? "fixed" : "estimated",
+      args.options.tilt_known ? "known" : "estimated");
   int failed_views = 0;
   std::vector<FitAccuracy> accuracies;
   const auto fit_views = args.rig ? FitRig : FitBundle;
@@ -150,6 +159,11 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
   fit->add_option("--focal", args->focal_px,
                   "known focal length in pixels (default: estimated)")
       ->check(CLI::PositiveNumber);
+  fit->add_option("--tilt", args->tilt_deg,
+                  "known camera tilt PITCH,ROLL in degrees (pitch positive "
+                  "looks down), held fixed (default: estimated)")
+      ->expected(2)
+      ->delimiter(',');
   fit->add_option("--config", args->config,
                   "FitOptions as YAML (docs/fit.md, \"Settings\"); the "
                   "flags above and below override it");

@@ -19,6 +19,7 @@
 #include "common/file_io.h"
 #include "env/reference.h"
 #include "env/reference_stream.h"
+#include "fit/camera_model.h"
 #include "fit/fit.h"
 #include "fit/fit_config.h"
 #include "gen/gen_config.h"
@@ -124,6 +125,15 @@ enum class GeneratedStart {
   kDefault,
 };
 
+// With GeneratedStart::kFit: the start fit's camera tilt. A generated
+// clip's view is chosen (--view), not filmed: its pitch and roll are known
+// and only approximated by the 2D, which a fit of a few seconds reads
+// 5-10 deg off (docs/generation.md 4b, "The start fit's tilt").
+enum class StartTilt {
+  kView,  // the --view camera's pitch and roll, held (fit/fit.h tilt_known)
+  kFit,   // estimated with the rest, as for a user's video (before 2026-12-07)
+};
+
 struct GenerateArgs {
   std::string run_dir;  // holds tokenizer.pt and prior.pt
   std::string output;
@@ -144,6 +154,7 @@ struct GenerateArgs {
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
+  StartTilt start_tilt = StartTilt::kView;  // with kFit: the camera's tilt
   // With kFit: FitOptions YAML for that fit ("": the defaults); whatever
   // the file says, the camera is moving and the focal is --focal's.
   std::string fit_config;
@@ -325,15 +336,29 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   fit_options.camera_motion = CameraMotion::kMoving;
   fit_options.fixed_focal_px = args.focal_px;
   fit_options.num_threads = 1;
+  if (args.start_tilt == StartTilt::kView) {
+    // Every azimuth's camera has --view's tilt.
+    const Eigen::Vector2d pitch_roll_rad =
+        CameraPitchRollRad(ViewCamera(args, args.view[0]));
+    fit_options.tilt_known = true;
+    fit_options.known_pitch_deg = pitch_roll_rad[0] * 180.0 / M_PI;
+    fit_options.known_roll_deg = pitch_roll_rad[1] * 180.0 / M_PI;
+  }
   fit_options.Validate();
   std::printf("tracking with %s: %zu stream(s) x %.0f s\n", args.policy.c_str(),
               sources.size(), args.seconds);
   if (args.start == GeneratedStart::kFit) {
+    char tilt[96] = "tilt estimated";
+    if (fit_options.tilt_known) {
+      std::snprintf(tilt, sizeof(tilt),
+                    "tilt --view's (pitch %.1f deg, roll %.1f deg)",
+                    fit_options.known_pitch_deg, fit_options.known_roll_deg);
+    }
     std::printf(
         "starts and cameras from the fit of each stream's first %.1f s "
-        "(moving camera, focal %.0f px, settings %s; no 3D), at %.1f s into "
-        "it, the camera dollying with the character\n",
-        args.start_fit_s, args.focal_px,
+        "(moving camera, focal %.0f px, %s, settings %s; no 3D), at %.1f s "
+        "into it, the camera dollying with the character\n",
+        args.start_fit_s, args.focal_px, tilt,
         args.fit_config.empty() ? "default" : args.fit_config.c_str(),
         StartAtS(args));
   } else {
@@ -742,6 +767,16 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->add_option("--start-fit-s", generate_args->start_fit_s,
                    "With --start fit: seconds of each stream fitted")
       ->check(CLI::Range(0.5, 60.0));
+  generate
+      ->add_option("--start-tilt", generate_args->start_tilt,
+                   "With --start fit: the start fit's camera pitch and roll: "
+                   "view (--view's, held: the view is chosen, not filmed; "
+                   "with --real, the recorded 2D's tilt said to be --view's) "
+                   "or fit (estimated, as for a video; before 2026-12-07)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, StartTilt>{{"view", StartTilt::kView},
+                                           {"fit", StartTilt::kFit}},
+          CLI::ignore_case));
   generate
       ->add_option("--fit-config", generate_args->fit_config,
                    "With --start fit: FitOptions YAML for the fit of each "

@@ -280,6 +280,8 @@ Parameters InitialParameters(const Observations& obs,
   Parameters params;
   params.camera.focal_px = focal_px;
   params.camera.pitch_roll_rad[0] = pitch_rad;
+  if (options.tilt_known)
+    params.camera.pitch_roll_rad[1] = options.known_roll_deg * M_PI / 180.0;
   const Eigen::Matrix3d rotation =
       FitCameraRotation(params.camera.pitch_roll_rad);
   const double cx = 0.5 * obs.width_px, cy = 0.5 * obs.height_px;
@@ -813,6 +815,9 @@ void AddCameraTerms(Stage stage, const FitOptions& options,
           {camera.pitch_roll_rad});
     }
     BoundCamera(camera, problem);
+    // A known tilt is the starts' and stays.
+    if (options.tilt_known)
+      problem.SetParameterBlockConstant(camera.pitch_roll_rad);
   }
   const int num_centres = static_cast<int>(camera.centres_m.size());
   for (int c = 0; c < num_centres; ++c) {
@@ -1411,6 +1416,12 @@ Parameters GivenParameters(const Observations& obs, const KinematicModel& model,
                            const std::vector<PinholeCamera>& cameras,
                            const std::vector<Pose3D>& poses,
                            const std::string& source) {
+  if (options.tilt_known) {
+    // The given camera's tilt defines the start's world.
+    throw ConfigError(
+        "fit: a refinement keeps its start's camera tilt (tilt_known "
+        "false)");
+  }
   if (static_cast<int>(poses.size()) != obs.num_frames) {
     throw InputError(source, "the start has " + std::to_string(poses.size()) +
                                  " poses for " +
@@ -1660,7 +1671,11 @@ ClipFit FitWholeClip(const Clip2D& clip, const Character& character,
   Parameters& best = fit.params;
   double best_cost = std::numeric_limits<double>::infinity();
   double best_turn_deg = 0.0;
-  double best_pitch_deg = options.pitch_starts_deg[0];
+  // A known tilt replaces the pitch starts.
+  const std::vector<double> pitch_starts_deg =
+      options.tilt_known ? std::vector<double>{options.known_pitch_deg}
+                         : options.pitch_starts_deg;
+  double best_pitch_deg = pitch_starts_deg[0];
   int num_starts_tried = 0;
   // One start: stage 1 to convergence, then the screening solve; the lowest
   // screening cost so far becomes `best`.
@@ -1697,22 +1712,31 @@ ClipFit FitWholeClip(const Clip2D& clip, const Character& character,
     std::snprintf(name, sizeof(name),
                   "start %d/%d (turned %.0f deg from facing the camera)", k + 1,
                   options.num_facing_starts, turn_deg);
-    try_start(turn_deg, options.pitch_starts_deg[0], name);
+    try_start(turn_deg, pitch_starts_deg[0], name);
   }
   // The best facing again from the other camera pitches: a camera looking
   // down on an upright body and a level one on a body leaning toward it
   // project almost alike, and a local solve from level does not cross
   // between the two.
-  for (size_t p = 1; p < options.pitch_starts_deg.size(); ++p) {
+  for (size_t p = 1; p < pitch_starts_deg.size(); ++p) {
     char name[64];
     std::snprintf(name, sizeof(name), "pitch start %zu/%zu (%.0f deg)", p + 1,
-                  options.pitch_starts_deg.size(), options.pitch_starts_deg[p]);
-    try_start(best_turn_deg, options.pitch_starts_deg[p], name);
+                  pitch_starts_deg.size(), pitch_starts_deg[p]);
+    try_start(best_turn_deg, pitch_starts_deg[p], name);
   }
-  char label[96];
-  std::snprintf(label, sizeof(label),
-                "turned %.0f deg from facing the camera, pitch start %.0f deg",
-                best_turn_deg, best_pitch_deg);
+  char label[128];
+  if (options.tilt_known) {
+    std::snprintf(label, sizeof(label),
+                  "turned %.0f deg from facing the camera, tilt known (pitch "
+                  "%.1f deg, roll %.1f deg, held)",
+                  best_turn_deg, options.known_pitch_deg,
+                  options.known_roll_deg);
+  } else {
+    std::snprintf(label, sizeof(label),
+                  "turned %.0f deg from facing the camera, pitch start %.0f "
+                  "deg",
+                  best_turn_deg, best_pitch_deg);
+  }
   summary.initialization = label;
 
   // Stage 1b: each limb searched from a grid of starts, frame by frame.
@@ -2083,6 +2107,11 @@ ReferenceBundle FitRig(
   if (options.camera_motion != CameraMotion::kStatic) {
     throw ConfigError(
         "fit --rig: a rig's cameras are static (camera_motion static)");
+  }
+  if (options.tilt_known) {
+    throw ConfigError(
+        "fit --rig: a known tilt is one camera's; a rig's cameras each "
+        "have their own (tilt_known false)");
   }
   if (num_views < 2) {
     throw InputError(source,

@@ -60,6 +60,15 @@ struct FitOptions {
   // with a prior at the image diagonal (a 53 deg diagonal field of view, as
   // CLIFF, GVHMR and WHAM assume).
   double fixed_focal_px = 0.0;
+  // true: the camera's tilt is known and held, pitch at known_pitch_deg
+  // (positive looks down) and roll at known_roll_deg; false: both
+  // estimated from the pitch starts. For clips whose view was chosen, not
+  // filmed: `generate --policy` fits the start of a clip it generated under
+  // --view, whose tilt the 2D only approximates (docs/fit.md, "A known
+  // tilt").
+  bool tilt_known = false;
+  double known_pitch_deg = 0.0;
+  double known_roll_deg = 0.0;
 
   // Data. Keypoints below this confidence are ignored.
   double min_confidence = 0.2;
@@ -215,6 +224,13 @@ struct FitOptions {
       "a tripod (one camera) or a smooth per-frame centre");
     v("fixed_focal_px", self.fixed_focal_px, Range::AtLeast(0),
       "> 0: the known focal length (px), held fixed; 0: estimated");
+    v("tilt_known", self.tilt_known, Range::Any(),
+      "true: the camera's pitch and roll are known_pitch_deg and "
+      "known_roll_deg, held fixed; false: estimated");
+    v("known_pitch_deg", self.known_pitch_deg, Range::Closed(-74, 74),
+      "with tilt_known: the camera's pitch (deg, positive looks down)");
+    v("known_roll_deg", self.known_roll_deg, Range::Closed(-40, 40),
+      "with tilt_known: the camera's roll about its optical axis (deg)");
     v("min_confidence", self.min_confidence, Range::Closed(0, 1),
       "keypoints below this confidence are ignored");
     v("reprojection_sigma", self.reprojection_sigma, Range::Above(0),
