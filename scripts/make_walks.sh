@@ -11,8 +11,10 @@
 # smoothness tilted 25 of the 36 views' worlds 14-35 deg). (Until
 # 2026-12-04: elevation 10 deg and the 1-s path.)
 #
-#   [FIT_THREADS=N] [ELEVATION=deg] scripts/make_walks.sh [OUT_DIR] [WALK...]
-#   (default runs/walks, all nine; the fit's threads, default 2)
+#   [FIT_THREADS=N] [ELEVATION=deg] [TILT=known] scripts/make_walks.sh [OUT_DIR] [WALK...]
+#   (default runs/walks, all nine; the fit's threads, default 2; TILT=known:
+#   the cameras' tilt given to the fit as the focal is, pitch ELEVATION and
+#   roll 0, held: docs/fit.md "A known tilt"; default estimated)
 #
 # Writes OUT_DIR/<walk>_truth.json (the measurement's side), <walk>_2d.json
 # (stripped) and <walk>.json (the fit's estimate: what training reads).
@@ -28,6 +30,12 @@ long="$shared/deepmimic/motions/long"
 source scripts/private_binary.sh
 private_binary  # $bin: a copy, so a rebuild meanwhile does not fail it
 mkdir -p "$out"
+tilt=()
+case ${TILT:-estimated} in
+  known) tilt=(--tilt "${ELEVATION:-15},0") ;;
+  estimated) ;;
+  *) echo "make_walks: TILT must be known or estimated" >&2; exit 2 ;;
+esac
 walks=("$@")
 if [ ${#walks[@]} -eq 0 ]; then
   walks=(long_walk1 long_walk1_mirror long_walk2 long_walk2_mirror long_walk3
@@ -42,7 +50,7 @@ for walk in "${walks[@]}"; do
     --distance 4.5 --focal 1000 --follow --follow-smoothing 0 -o "$out/${walk}_truth.json" > /dev/null
   $bin clip strip "$out/${walk}_truth.json" -o "$out/${walk}_2d.json" \
     > /dev/null
-  if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 \
+  if $bin fit "$out/${walk}_2d.json" --camera moving --focal 1000 "${tilt[@]}" \
     --config configs/fit/root_dolly.yaml --threads "${FIT_THREADS:-2}" \
     --quiet -o "$out/$walk.json" > "$out/${walk}_fit.log" 2>&1;
   then
