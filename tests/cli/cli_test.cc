@@ -135,8 +135,12 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
       << result.output;
   EXPECT_EQ(CountOccurrences(result.output, "fit of its first 30 frames"), 4)
       << result.output;
-  // and starts in the middle of the fitted seconds.
+  // and starts in the middle of the fitted seconds; the generated view's
+  // tilt (--view's default elevation 10 deg) is held in that fit.
   EXPECT_NE(result.output.find("at 0.5 s into it"), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("tilt --view's (pitch 10.0 deg, roll 0.0 deg)"),
+            std::string::npos)
       << result.output;
   result = RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " +
                       policy + " --start default --start-fit-s 1 -o " + dir +
@@ -159,7 +163,8 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   ASSERT_EQ(result.exit_code, 0) << result.output;
   result = RunMimic2d("generate " + dir + "/gen --seconds 3 --policy " +
                       policy + " --real " + dir +
-                      "/real.json --start-at-s 0.5 --fit-config " +
+                      "/real.json --start-at-s 0.5 --start-tilt fit "
+                      "--fit-config " +
                       testing::SourcePath("configs/fit/root_dolly.yaml") +
                       " -o " + dir + "/unused.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
@@ -168,6 +173,8 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
       result.output.find("settings " +
                          testing::SourcePath("configs/fit/root_dolly.yaml")),
       std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("tilt estimated"), std::string::npos)
       << result.output;
   EXPECT_EQ(CountOccurrences(result.output, "tracked to the end"), 2)
       << result.output;
