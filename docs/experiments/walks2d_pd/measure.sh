@@ -18,6 +18,9 @@
 # seconds fitted, default 2) and --start-at-s (where the rollout starts,
 # default the middle of the fitted seconds); figures before 2026-12-07 are
 # of the defaults.
+# START_TILT: generate's --start-tilt: view (the default since 2026-12-07's
+# second session: the start fits hold --view's tilt) or fit (estimated, as
+# every figure before it).
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 checkpoint=$1 out=$2
@@ -25,6 +28,7 @@ start_options=()
 [ -n "${FIT_CONFIG:-}" ] && start_options=(--fit-config "$FIT_CONFIG")
 [ -n "${START_FIT_S:-}" ] && start_options+=(--start-fit-s "$START_FIT_S")
 [ -n "${START_AT_S:-}" ] && start_options+=(--start-at-s "$START_AT_S")
+[ -n "${START_TILT:-}" ] && start_options+=(--start-tilt "$START_TILT")
 for ((draw = 0; draw < ${DRAWS:-1}; ++draw)); do
   suffix=""
   [ "$draw" -gt 0 ] && suffix="_$draw"
