@@ -128,7 +128,8 @@ enum class GeneratedStart {
 // With GeneratedStart::kFit: the start fit's camera tilt. A generated
 // clip's view is chosen (--view), not filmed: its pitch and roll are known
 // and only approximated by the 2D, which a fit of a few seconds reads
-// 5-10 deg off (docs/generation.md 4b, "The start fit's tilt").
+// 5-10 deg off (docs/generation.md 4b, "The measure's camera, the horizon
+// and the fits' tilt").
 enum class StartTilt {
   kView,  // the --view camera's pitch and roll, held (fit/fit.h tilt_known)
   kFit,   // estimated with the rest, as for a user's video (before 2026-12-07)
