@@ -174,9 +174,10 @@ void AddFitCommand(CLI::App& app, CommandRun* run) {
       ->check(CLI::PositiveNumber);
   fit->add_flag("--quiet", args->quiet, "no per-stage progress lines");
   fit->add_flag("--rig", args->rig,
-                "the views are one synchronized take of static cameras (a "
-                "calibrated rig): one body fitted to all of them, each "
-                "camera placed in one world (docs/fit.md, \"A rig\")");
+                "the views are one synchronized take (a calibrated rig of "
+                "static cameras, or cameras that all follow the subject "
+                "with --camera moving): one body fitted to all of them, "
+                "each camera placed in one world (docs/fit.md, \"A rig\")");
   fit->add_option("--truth", args->truth,
                   "bundle holding the input's 3D truth and true cameras (a "
                   "stripped bundle's original): each view's fit is measured "

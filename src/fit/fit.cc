@@ -626,6 +626,11 @@ void RemoveContactSlide(const Observations& obs, const KinematicModel& model,
   for (int t = 0; t < num_frames; ++t) {
     params.root_m[t].head<2>() += shift[t];
     params.camera.centres_m[t].head<2>() += shift[t];
+    // A rig's other following cameras see the same body: they move with it.
+    for (CameraParameters& camera : params.rig_cameras) {
+      if (camera.centres_m.size() > 1)
+        camera.centres_m[t].head<2>() += shift[t];
+    }
   }
 }
 
@@ -1487,7 +1492,10 @@ constexpr int kRigCameraYawStarts = 8;
 // camera; its focal held, its pitch and roll the start), the camera alone
 // solved to its view `obs`; the lowest reprojection cost wins. Its own
 // fit's body is not used: a depth or facing its fit got wrong would misplace
-// it.
+// it. A moving camera (one centre per frame in `alone`) starts on the
+// body's root path, frame by frame, at that distance and heading and at its
+// own fit's height of the frame, and is solved under its speed and
+// smoothness terms (AddCameraTerms).
 CameraParameters PlaceRigCamera(const Observations& obs,
                                 const KinematicModel& model,
                                 const FitOptions& options,
@@ -1501,14 +1509,18 @@ CameraParameters PlaceRigCamera(const Observations& obs,
   const std::vector<double> all_keypoints(obs.num_keypoints, 1.0);
   CameraParameters best;
   double best_cost = std::numeric_limits<double>::infinity();
+  const bool moving = alone.centres_m.size() > 1;
   for (int start = 0; start < kRigCameraYawStarts; ++start) {
     CameraParameters camera = alone;
     camera.yaw_rad = 2.0 * M_PI * start / kRigCameraYawStarts;
-    camera.centres_m.assign(
-        1,
-        Eigen::Vector3d(mean_root.x() - distance_m * std::cos(camera.yaw_rad),
-                        mean_root.y() - distance_m * std::sin(camera.yaw_rad),
-                        alone.centres_m[0].z()));
+    const Eigen::Vector2d back_m(distance_m * std::cos(camera.yaw_rad),
+                                 distance_m * std::sin(camera.yaw_rad));
+    for (size_t c = 0; c < camera.centres_m.size(); ++c) {
+      const Eigen::Vector2d under_m =
+          (moving ? body.root_m[c] : mean_root).head<2>() - back_m;
+      camera.centres_m[c] =
+          Eigen::Vector3d(under_m.x(), under_m.y(), alone.centres_m[c].z());
+    }
     ceres::Problem problem;
     for (int t = 0; t < obs.num_frames; ++t) {
       problem.AddResidualBlock(
@@ -1521,10 +1533,20 @@ CameraParameters PlaceRigCamera(const Observations& obs,
         problem.SetParameterBlockConstant(block);
       }
     }
+    if (moving) {
+      AddCameraTerms(Stage::kPose, options, camera.focal_px, false, camera,
+                     problem, nullptr);
+    } else {
+      BoundCamera(camera, problem);
+    }
     problem.SetParameterBlockConstant(&camera.focal_px);
-    BoundCamera(camera, problem);
     ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;  // 7 unknowns
+    // 7 unknowns, or 3 per frame along a banded chain for a moving camera.
+    solver.linear_solver_type =
+        moving ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
+    if (moving &&
+        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
+      solver.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
     solver.max_num_iterations = options.root_stage_iterations;
     solver.function_tolerance = options.function_tolerance;
     solver.logging_type = ceres::SILENT;
@@ -2104,10 +2126,6 @@ ReferenceBundle FitRig(
   options.Validate();
   const auto started = std::chrono::steady_clock::now();
   const int num_views = static_cast<int>(bundle.views.size());
-  if (options.camera_motion != CameraMotion::kStatic) {
-    throw ConfigError(
-        "fit --rig: a rig's cameras are static (camera_motion static)");
-  }
   if (options.tilt_known) {
     throw ConfigError(
         "fit --rig: a known tilt is one camera's; a rig's cameras each "
@@ -2150,8 +2168,11 @@ ReferenceBundle FitRig(
     own.push_back(GivenParameters(obs[v], model, character, options,
                                   alone.cameras, alone.poses, sources[v]));
     double sum = 0.0;
-    for (const Eigen::Vector3d& root : own.back().root_m)
-      sum += (root - own.back().camera.centres_m[0]).head<2>().norm();
+    for (int t = 0; t < obs[v].num_frames; ++t) {
+      sum += (own.back().root_m[t] - Eigen::Vector3d(own.back().centre(t)))
+                 .head<2>()
+                 .norm();
+    }
     distance_m.push_back(sum / obs[v].num_frames);
   }
 
