@@ -11,10 +11,13 @@
 # smoothness tilted 25 of the 36 views' worlds 14-35 deg). (Until
 # 2026-12-04: elevation 10 deg and the 1-s path.)
 #
-#   [FIT_THREADS=N] [ELEVATION=deg] [TILT=known] scripts/make_walks.sh [OUT_DIR] [WALK...]
+#   [FIT_THREADS=N] [ELEVATION=deg] [TILT=known|rig] scripts/make_walks.sh [OUT_DIR] [WALK...]
 #   (default runs/walks, all nine; the fit's threads, default 2; TILT=known:
 #   the cameras' tilt given to the fit as the focal is, pitch ELEVATION and
-#   roll 0, held: docs/fit.md "A known tilt"; default estimated)
+#   roll 0, held: docs/fit.md "A known tilt"; TILT=rig: each walk's four
+#   following views fitted together as one rig, every camera's tilt
+#   estimated from the 2D: docs/fit.md "A rig"; default estimated, each
+#   view alone)
 #
 # Writes OUT_DIR/<walk>_truth.json (the measurement's side), <walk>_2d.json
 # (stripped) and <walk>.json (the fit's estimate: what training reads).
@@ -33,8 +36,9 @@ mkdir -p "$out"
 tilt=()
 case ${TILT:-estimated} in
   known) tilt=(--tilt "${ELEVATION:-15},0") ;;
+  rig) tilt=(--rig) ;;
   estimated) ;;
-  *) echo "make_walks: TILT must be known or estimated" >&2; exit 2 ;;
+  *) echo "make_walks: TILT must be known, rig or estimated" >&2; exit 2 ;;
 esac
 walks=("$@")
 if [ ${#walks[@]} -eq 0 ]; then

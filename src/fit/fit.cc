@@ -2176,6 +2176,12 @@ ReferenceBundle FitRig(
     distance_m.push_back(sum / obs[v].num_frames);
   }
 
+  // The joint stages' options: a rig of moving cameras with its own
+  // uprightness (FitOptions::moving_rig_upright_weight).
+  FitOptions rig_options = options;
+  if (options.camera_motion == CameraMotion::kMoving)
+    rig_options.upright_weight = options.moving_rig_upright_weight;
+
   // Every view's body as the start; the others' cameras placed against it.
   // The best start keeps its state, its view's priors and the other views.
   struct RigStart {
@@ -2194,13 +2200,13 @@ ReferenceBundle FitRig(
     for (int k = 0; k < num_views; ++k) {
       if (k == m) continue;
       params.rig_cameras.push_back(
-          PlaceRigCamera(obs[k], model, options, priors, own[k].camera,
+          PlaceRigCamera(obs[k], model, rig_options, priors, own[k].camera,
                          distance_m[k], params, &iterations));
       rig_obs.push_back(obs[k]);
     }
     const StageResult screen =
         SolveStage(Stage::kPose, options.screening_iterations, obs[m], model,
-                   layout, options, priors, nullptr, params, rig_obs);
+                   layout, rig_options, priors, nullptr, params, rig_obs);
     iterations += screen.iterations;
     char line[160];
     std::snprintf(line, sizeof(line),
@@ -2229,9 +2235,9 @@ ReferenceBundle FitRig(
   summary.iterations = iterations;
   summary.initial_cost = best.screen.initial_cost;
   std::vector<ViewEstimate> estimates(num_views);
-  estimates[m] =
-      SolvePoseAndReport(obs[m], model, layout, character, options, best.priors,
-                         started, summary, best.params, best.rig_obs);
+  estimates[m] = SolvePoseAndReport(obs[m], model, layout, character,
+                                    rig_options, best.priors, started, summary,
+                                    best.params, best.rig_obs);
   for (int k = 0, i = 0; k < num_views; ++k) {
     if (k == m) continue;
     estimates[k] =

@@ -108,11 +108,18 @@ struct FitOptions {
   // than self_contact_margin_m when a stage's solve is built are watched.
   double self_contact_weight = 20.0;
   double self_contact_margin_m = 0.05;
-  double foot_slide_weight = 30.0;        // in-contact sole point step (m)
-  double camera_smooth_weight = 400.0;    // moving centre accel., m/frame^2
-  double camera_speed_weight = 0.5;       // moving centre speed, m per frame
-  double focal_prior_weight = 2.0;        // log(focal / prior)
-  double upright_weight = 0.5;            // root up axis, horizontal part
+  double foot_slide_weight = 30.0;      // in-contact sole point step (m)
+  double camera_smooth_weight = 400.0;  // moving centre accel., m/frame^2
+  double camera_speed_weight = 0.5;     // moving centre speed, m per frame
+  double focal_prior_weight = 2.0;      // log(focal / prior)
+  double upright_weight = 0.5;          // root up axis, horizontal part
+  // The same in a rig of moving cameras' joint stages (FitRig; each view's
+  // own fit keeps upright_weight). One view cannot tell a leaning body from
+  // a tilted camera, and the term holds the body upright; a rig's views pin
+  // the pose, and the term then tilts the whole world under a body that
+  // really leans (a stealthy walk: 8 deg at 0.5, 2-4 deg at 0; docs/fit.md,
+  // "A rig").
+  double moving_rig_upright_weight = 0.0;
   double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
   // Balance (stage 3, frames with a sole in contact): the zero-moment point
   // outside the in-contact soles' box grown by the margin (m); the centre
@@ -273,6 +280,8 @@ struct FitOptions {
       "log(focal / prior at the image diagonal)");
     v("upright_weight", self.upright_weight, weight,
       "horizontal part of the root's up axis");
+    v("moving_rig_upright_weight", self.moving_rig_upright_weight, weight,
+      "the same in a rig of moving cameras' joint stages");
     v("camera_roll_prior_weight", self.camera_roll_prior_weight, weight,
       "camera roll (rad) from level");
     v("balance_weight", self.balance_weight, weight,

@@ -832,9 +832,10 @@ TEST(Fit, ARigsViewsFittedTogetherShareOneBodyAndWorld) {
 // Cameras that all follow the subject (a dolly on its root) fitted as one
 // rig: one body under every camera, each camera's own path, and the tilt
 // that a single following view leaves loose (docs/fit.md, "A rig").
-// Measured: pitch and roll within 2.6 deg (each view alone: within 4.5),
-// root-relative 21 mm, each camera 0.01 m off the truth's distance to the
-// root at the clip's ends.
+// Measured: pitch and roll within 1.2 deg (2.6 with the upright term at
+// 0.5 in the joint stages; each view alone: within 4.5), root-relative 6 mm,
+// each camera 0.01 m off the truth's distance to the root at the clip's
+// ends.
 TEST(Fit, ARigOfFollowingCamerasRecoversEachCamerasTilt) {
   auto character = Humanoid();
   const ReferenceBundle bundle =
@@ -871,8 +872,8 @@ TEST(Fit, ARigOfFollowingCamerasRecoversEachCamerasTilt) {
         "%.0f mm, camera-to-root %.2f m off, %.1f px\n",
         v, error[0] * 180 / M_PI, error[1] * 180 / M_PI, error_m * 1000,
         path_error_m, estimate.summary.mean_reprojection_px);
-    EXPECT_LT(error.cwiseAbs().maxCoeff(), 4 * M_PI / 180);
-    EXPECT_LT(error_m, 0.06);
+    EXPECT_LT(error.cwiseAbs().maxCoeff(), 3 * M_PI / 180);
+    EXPECT_LT(error_m, 0.03);
     EXPECT_LT(path_error_m, 0.5);
     EXPECT_LT(estimate.summary.mean_reprojection_px, 5.0);
     for (size_t t = 0; t < estimate.poses.size(); t += 7) {
