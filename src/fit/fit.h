@@ -117,7 +117,7 @@ struct FitOptions {
   // own fit keeps upright_weight). One view cannot tell a leaning body from
   // a tilted camera, and the term holds the body upright; a rig's views pin
   // the pose, and the term then tilts the whole world under a body that
-  // really leans (a stealthy walk: 8 deg at 0.5, 2-4 deg at 0; docs/fit.md,
+  // really leans (a stealthy walk: 8 deg at 0.5, 0.2 at 0; docs/fit.md,
   // "A rig").
   double moving_rig_upright_weight = 0.0;
   double camera_roll_prior_weight = 0.0;  // camera roll (rad) from level
