@@ -874,7 +874,7 @@ TEST(Fit, ARigOfFollowingCamerasRecoversEachCamerasTilt) {
         path_error_m, estimate.summary.mean_reprojection_px);
     EXPECT_LT(error.cwiseAbs().maxCoeff(), 3 * M_PI / 180);
     EXPECT_LT(error_m, 0.03);
-    EXPECT_LT(path_error_m, 0.5);
+    EXPECT_LT(path_error_m, 0.1);
     EXPECT_LT(estimate.summary.mean_reprojection_px, 5.0);
     for (size_t t = 0; t < estimate.poses.size(); t += 7) {
       EXPECT_TRUE(estimate.poses[t].root_position_m.isApprox(
