@@ -10,10 +10,13 @@
 # 1-18 (docs/experiments/walks2d_pd/measure.sh), so that no measured stream
 # is trained on.
 #
-#   [FIT_THREADS=N] [SECONDS_PER_CLIP=s] [SEED_BASE=n] \
+#   [FIT_THREADS=N] [SECONDS_PER_CLIP=s] [SEED_BASE=n] [TILT=view] \
 #     scripts/make_generated_walks.sh [OUT_DIR] [MOTION...]
 #   (default runs/gen_clips, motions 0-8; 20 s per clip; the fit's threads,
 #   default 2)
+# TILT=view: the fit holds the chosen view's tilt (pitch 15 deg, roll 0), as
+# generate --policy's start fits do (--start-tilt view: a generated view is
+# chosen, not filmed; docs/fit.md "A known tilt"); default: estimated.
 #
 # Writes OUT_DIR/m<motion>_az<azimuth>_2d.json (the generated 2D) and
 # OUT_DIR/m<motion>_az<azimuth>.json (its fit: what training reads).
@@ -33,6 +36,12 @@ mkdir -p "$out"
 motions=("$@")
 [ ${#motions[@]} -eq 0 ] && motions=(0 1 2 3 4 5 6 7 8)
 azimuths=(30 120 210 300)
+tilt=()
+case ${TILT:-} in
+  "") ;;
+  view) tilt=(--tilt "15,0") ;;
+  *) echo "make_generated_walks: TILT must be view or unset" >&2; exit 2 ;;
+esac
 
 for motion in "${motions[@]}"; do
   for a in "${!azimuths[@]}"; do
@@ -43,7 +52,7 @@ for motion in "${motions[@]}"; do
     $bin generate runs/gen_walks --seconds "${SECONDS_PER_CLIP:-20}" \
       --view "$azimuth,15,4.5" --focal 1000 --motion "$motion" \
       --seed "$seed" -o "$out/${name}_2d.json" > /dev/null
-    if $bin fit "$out/${name}_2d.json" --camera moving --focal 1000 \
+    if $bin fit "$out/${name}_2d.json" --camera moving --focal 1000 "${tilt[@]}" \
       --config configs/fit/root_dolly.yaml --threads "${FIT_THREADS:-2}" \
       --quiet -o "$out/$name.json" > "$out/${name}_fit.log" 2>&1; then
       echo "fitted $name (seed $seed): $(grep -c 'all frames converged' \

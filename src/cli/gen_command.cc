@@ -585,7 +585,12 @@ int RunGenEval(const GenEvalArgs& args) {
          args.options.generation.decoding.context_codes},
         {"lookahead_codes", args.options.generation.decoding.lookahead_codes},
         {"emit_codes", args.options.generation.decoding.emit_codes},
+        {"blend_seams", args.options.generation.decoding.blend_seams},
         {"placement_return_s", args.options.generation.placement_return_s},
+        {"jump_threshold", result.jump_threshold},
+        {"jumps_per_min_generated", result.jumps_per_min_generated},
+        {"jumps_per_min_stream", result.jumps_per_min_stream},
+        {"jump_share_at_seams", result.jump_share_at_seams},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},
         {"neighbours", args.options.neighbours},
@@ -626,6 +631,17 @@ void AddGenerationOptions(CLI::App* command, GenerationOptions* generation) {
       "Time constant (s) with which the stream's scale and root return "
       "toward their start, as the data's following cameras hold them "
       "(default 20; 0: off)");
+  StreamDecoding* decoding = &generation->decoding;
+  command->add_option("--decode-context", decoding->context_codes,
+                      "Codes the streaming decoder sees per step");
+  command->add_option("--lookahead", decoding->lookahead_codes,
+                      "Codes decoded after the ones emitted (latency)");
+  command->add_option("--emit-codes", decoding->emit_codes,
+                      "Codes whose frames one decoding emits");
+  command->add_option(
+      "--blend-seams", decoding->blend_seams,
+      "Fade each decoding's first frames in from what the previous one "
+      "decoded for them (default true; false: the seams as decoded)");
 }
 
 }  // namespace
@@ -676,15 +692,6 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
                    "Motions the feature encoder is trained on (never the "
                    "generator's)")
       ->delimiter(',');
-  eval->add_option("--decode-context",
-                   eval_args->options.generation.decoding.context_codes,
-                   "Codes the streaming decoder sees per step");
-  eval->add_option("--lookahead",
-                   eval_args->options.generation.decoding.lookahead_codes,
-                   "Codes decoded after the ones emitted (latency)");
-  eval->add_option("--emit-codes",
-                   eval_args->options.generation.decoding.emit_codes,
-                   "Codes whose frames one decoding emits");
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
   eval->add_option("--time-segments", eval_args->options.time_segments,

@@ -170,12 +170,23 @@ struct StreamDecoding {
   // makes the seams between codes show.
   int context_codes = 16;
   // Codes decoded after the one emitted (latency, 4 frames each): the
-  // decoder is least sure at the window's open edge.
-  int lookahead_codes = 1;
+  // decoder is least sure at the window's open edge. 2 since 2026-12-07
+  // (was 1): with blend_seams the seams' overlap is the lookahead's frames,
+  // and 8 frames blend the styles' seams to their real 2D's speeds.
+  int lookahead_codes = 2;
   // Codes whose frames one decoding emits: the decoder runs once per this
   // many codes (its cost shared by their frames) at this many codes' more
   // latency. They sit just before the lookahead in the window.
   int emit_codes = 4;
+  // Each decoding is its own pass, and two passes disagree where they meet:
+  // the last code one emits had only the lookahead after it, the next
+  // pass's first code has more. Unblended, every seam (each emit_codes
+  // codes) jumps: on the long walks' styles 35-43 frames a minute moved a
+  // keypoint faster than any frame of their real 2D, all of them at seams
+  // (docs/generation.md, "Seams"). Blended, the next pass's first
+  // lookahead frames fade in from what the previous pass decoded for them
+  // (weights (i + 1) / (n + 1) on the new pass, n = the overlap's frames).
+  bool blend_seams = true;
 };
 
 // One generation: how its codes are drawn and decoded, its seed and view,

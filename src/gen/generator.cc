@@ -113,6 +113,11 @@ std::string GeneratorEvalResult::BriefReport() const {
       << drift_log_scale_generated << ", real " << drift_log_scale_real
       << "; root generated " << drift_root_generated << ", real "
       << drift_root_real << " body scales\n"
+      << "jumps (a frame's largest keypoint step past the real data's 99.9th "
+      << "percentile, " << jump_threshold << " body scales) per minute: "
+      << "generated " << jumps_per_min_generated << " ("
+      << 100.0 * jump_share_at_seams << " % at decoding seams), real codes "
+      << "decoded as a stream " << jumps_per_min_stream << ", real 1.8\n"
       << "generation speed " << realtime_factor
       << "x real time (1 thread, tokens + decoding)\n";
   return out.str();
@@ -205,6 +210,31 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                         FitFeatureGaussian(real_features));
   }
 
+  // Jumps: the real data's 99.9th percentile of the largest keypoint step
+  // per frame is the threshold; how often a set of sequences passes it.
+  {
+    std::vector<double> real_steps;
+    for (const GenSequence& sequence : real.sequences) {
+      const std::vector<double> steps = LargestPoseSteps(sequence, frame_size);
+      real_steps.insert(real_steps.end(), steps.begin(), steps.end());
+    }
+    if (!real_steps.empty()) {
+      const size_t at = static_cast<size_t>(0.999 * (real_steps.size() - 1));
+      std::nth_element(real_steps.begin(), real_steps.begin() + at,
+                       real_steps.end());
+      result.jump_threshold = real_steps[at];
+    }
+  }
+  auto jumps_per_min = [&](const std::vector<GenSequence>& sequences) {
+    double jumps = 0.0, frames = 0.0;
+    for (const GenSequence& sequence : sequences) {
+      for (double step : LargestPoseSteps(sequence, frame_size))
+        jumps += step > result.jump_threshold;
+      frames += sequence.num_frames;
+    }
+    return frames > 0 ? jumps / (frames / real.fps / 60.0) : 0.0;
+  };
+
   // The streaming decoder alone: the codes the prior learns (every real
   // sequence encoded whole) decoded as a generation's are.
   {
@@ -221,6 +251,7 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       streamed.push_back({"streamed/" + std::to_string(i),
                           static_cast<int>(frames), std::move(rows)});
     }
+    result.jumps_per_min_stream = jumps_per_min(streamed);
     result.fid_stream_reconstruction = FrechetDistance(
         FitFeatureGaussian(EncodeWindows(encoder, windows_of(streamed))),
         FitFeatureGaussian(real_features));
@@ -310,6 +341,21 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     *log_scale = std::sqrt(scale_sum / count);
     *root = std::sqrt(root_sum / count);
   };
+  result.jumps_per_min_generated = jumps_per_min(generated);
+  {
+    const int seam_frames = options.generation.decoding.emit_codes *
+                            tokenizer.model->frames_per_token();
+    double jumps = 0.0, at_seams = 0.0;
+    for (const GenSequence& sequence : generated) {
+      const std::vector<double> steps = LargestPoseSteps(sequence, frame_size);
+      for (size_t i = 0; i < steps.size(); ++i) {
+        if (steps[i] <= result.jump_threshold) continue;
+        ++jumps;
+        at_seams += (i + 1) % seam_frames == 0;  // step i ends at frame i + 1
+      }
+    }
+    result.jump_share_at_seams = jumps > 0 ? at_seams / jumps : 0.0;
+  }
   rms_drift(generated, &result.drift_log_scale_generated,
             &result.drift_root_generated);
   rms_drift(DrawRealStretches(real.sequences, frame_size, generation_frames,

@@ -196,6 +196,24 @@ PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size) {
   return drift;
 }
 
+std::vector<double> LargestPoseSteps(const GenSequence& sequence,
+                                     int frame_size) {
+  const int keypoints = RootStepColumn(frame_size) / 2;
+  std::vector<double> steps;
+  for (int t = 1; t < sequence.num_frames; ++t) {
+    const float* row =
+        sequence.features.data() + static_cast<size_t>(t) * frame_size;
+    const float* before = row - frame_size;
+    double largest = 0.0;
+    for (int j = 0; j < keypoints; ++j)
+      largest = std::max(
+          largest, std::hypot(static_cast<double>(row[2 * j] - before[2 * j]),
+                              row[2 * j + 1] - before[2 * j + 1]));
+    steps.push_back(largest);
+  }
+  return steps;
+}
+
 PlacementAnchor::PlacementAnchor(double return_time_s, double fps) {
   if (!(return_time_s >= 0.0 && std::isfinite(return_time_s)) || !(fps > 0))
     throw ConfigError(

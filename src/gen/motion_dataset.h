@@ -150,6 +150,14 @@ struct PlacementDrift {
 };
 PlacementDrift PlacementDriftOf(const GenSequence& sequence, int frame_size);
 
+// Each frame's largest keypoint step from the frame before, in the local
+// pose x̄ (body scales; the first frame has none, so num_frames - 1
+// values): how fast the 2D a tracker follows moves. Real motion has few
+// large ones; a generator that jumps where the motion does not (the seams
+// between its decodings, gen/motion_stream.h) asks a limb to teleport.
+std::vector<double> LargestPoseSteps(const GenSequence& sequence,
+                                     int frame_size);
+
 // Holds a stream's placement near its start, as the data's following
 // cameras do: each frame's log-scale and root steps give back
 // 1 / (return_time_s * fps) of the log scale and root displacement

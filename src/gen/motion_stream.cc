@@ -74,8 +74,10 @@ void MotionStream::Next(std::vector<float>* rows) {
   // Inference only: no autograd bookkeeping on any tensor made here.
   c10::InferenceMode inference;
   // Outline: when nothing decoded is left, draw codes until the lookahead
-  // after the next emit_codes codes exists, decode the latest codes and
-  // keep the frames of those emit_codes; then emit one code's frames.
+  // after the next emit_codes codes exists, decode the latest codes, keep
+  // the frames of those emit_codes (their first ones blended in from the
+  // previous decoding's lookahead) and this decoding's lookahead frames;
+  // then emit one code's frames.
   const int per_token = frames_per_token();
   const size_t row_size = static_cast<size_t>(frame_size());
   if (next_decoded_row_ * row_size >= decoded_.size()) {
@@ -94,13 +96,24 @@ void MotionStream::Next(std::vector<float>* rows) {
             torch::kLong)
             .unsqueeze(0);
     torch::Tensor frames = tokenizer_.model->Decode(window)[0];  // [T, C]
-    torch::Tensor kept = (frames.narrow(0, (emitted_codes_ - begin) * per_token,
-                                        decoding.emit_codes * per_token) *
-                              tokenizer_.std +
-                          tokenizer_.mean)
-                             .contiguous();
-    decoded_.assign(kept.data_ptr<float>(),
-                    kept.data_ptr<float>() + kept.numel());
+    frames = (frames * tokenizer_.std + tokenizer_.mean).contiguous();
+    const float* first_kept = frames.data_ptr<float>() +
+                              (emitted_codes_ - begin) * per_token * row_size;
+    const size_t kept_size = decoding.emit_codes * per_token * row_size;
+    decoded_.assign(first_kept, first_kept + kept_size);
+    if (decoding.blend_seams) {
+      const size_t overlap = std::min(lookahead_.size(), decoded_.size());
+      const size_t overlap_rows = overlap / row_size;
+      for (size_t i = 0; i < overlap; ++i) {
+        const float weight = static_cast<float>(i / row_size + 1) /
+                             static_cast<float>(overlap_rows + 1);
+        decoded_[i] = (1.0f - weight) * lookahead_[i] + weight * decoded_[i];
+      }
+      const float* first_lookahead = first_kept + kept_size;
+      lookahead_.assign(
+          first_lookahead,
+          first_lookahead + decoding.lookahead_codes * per_token * row_size);
+    }
     anchor_.Apply(decoded_.data(), static_cast<int>(decoded_.size() / row_size),
                   static_cast<int>(row_size));
     next_decoded_row_ = 0;

@@ -54,7 +54,10 @@ class MotionStream {
   GenerationOptions options_;
   PlacementAnchor anchor_;  // holds the emitted rows' placement
   int64_t emitted_codes_ = 0;
-  std::vector<float> decoded_;   // frames decoded, not yet emitted
+  std::vector<float> decoded_;  // frames decoded, not yet emitted
+  // The last decoding's lookahead frames (not normalized, before the
+  // anchor): what the next decoding's first frames blend in from.
+  std::vector<float> lookahead_;
   size_t next_decoded_row_ = 0;  // in decoded_, in rows
 };
 

@@ -201,6 +201,54 @@ TEST(GenTrainer, TheTrainedGeneratorStreamsFrames) {
       ConfigError);
 }
 
+// Each decoding's first frames fade in from what the decoding before it
+// made of them in its lookahead: the seam between two decoder passes does
+// not jump (gen_config.h, StreamDecoding::blend_seams).
+TEST(GenTrainer, ADecodingFadesInFromThePreviousOnesLookahead) {
+  const GenConfig config = TinyConfig(TempRun("seams"));
+  TrainGenerator(config, WalkDataset(), false, nullptr, nullptr);
+  auto stream_rows = [&](int emit_codes, int lookahead_codes, bool blend) {
+    GenerationOptions options;
+    options.seed = 7;
+    options.placement_return_s = 0.0;  // the rows as decoded
+    options.decoding.emit_codes = emit_codes;
+    options.decoding.lookahead_codes = lookahead_codes;
+    options.decoding.blend_seams = blend;
+    MotionStream stream(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
+                        LoadPrior(config.run.run_dir + "/prior.pt"), options);
+    std::vector<float> rows;
+    for (int i = 0; i < 8; ++i) stream.Next(&rows);
+    return rows;
+  };
+  const size_t row = 37;
+  const std::vector<float> blended = stream_rows(4, 1, true);
+  const std::vector<float> seams = stream_rows(4, 1, false);
+  // The first decoding's window, codes 0..4, decoded with code 4 emitted:
+  // what the blended stream's first decoding saw in its lookahead.
+  const std::vector<float> lookahead = stream_rows(5, 0, false);
+  ASSERT_EQ(blended.size(), 8 * 4 * row);
+  ASSERT_EQ(seams.size(), blended.size());
+  int differing = 0;
+  for (size_t i = 0; i < blended.size(); ++i) {
+    const size_t frame = i / row;
+    if (frame < 16 || frame >= 20) {
+      // The first decoding has nothing before it; after the overlap the
+      // second decoding's own frames.
+      ASSERT_FLOAT_EQ(blended[i], seams[i]) << "frame " << frame;
+    } else {
+      // Code 4's frames: weights 1/5 .. 4/5 on the second decoding.
+      const float weight = static_cast<float>(frame - 16 + 1) / 5.0f;
+      EXPECT_NEAR(blended[i],
+                  (1.0f - weight) * lookahead[i] + weight * seams[i], 1e-5)
+          << "frame " << frame;
+      differing += std::abs(lookahead[i] - seams[i]) > 1e-4f;
+    }
+  }
+  EXPECT_GT(differing, 0);  // the two passes disagreed at the seam
+  // Without a lookahead there is nothing to fade in from.
+  EXPECT_EQ(stream_rows(4, 0, true), stream_rows(4, 0, false));
+}
+
 // Replayed, a stream's codes decode to the frames the drawing stream
 // emitted (the eval's stream-reconstruction FID decodes real codes so), and
 // the replay says how many frames its codes hold and stops there.
@@ -215,9 +263,9 @@ TEST(GenTrainer, ReplayedCodesDecodeAsTheDrawnOnes) {
   std::vector<float> rows;
   for (int i = 0; i < 12; ++i) drawn.Next(&rows);  // past the context
   EXPECT_EQ(drawn.frames_available(), 0);          // drawing: no limit
-  // Decoding 4 codes at a time with 1 of lookahead: 12 emitted codes drew
-  // 13 (the third decoding needed codes 8..12).
-  ASSERT_EQ(drawn.codes().size(), 13u);
+  // Decoding 4 codes at a time with 2 of lookahead: 12 emitted codes drew
+  // 14 (the third decoding needed codes 8..13).
+  ASSERT_EQ(drawn.codes().size(), 14u);
   MotionStream replayed(LoadTokenizer(config.run.run_dir + "/tokenizer.pt"),
                         drawn.codes(), options);
   EXPECT_EQ(replayed.frames_available(), 12 * 4);
@@ -320,6 +368,12 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
     EXPECT_GE(drift, 0.0);
   }
   EXPECT_GT(result.realtime_factor, 1.0);
+  // Jumps: counted against a threshold the real data sets.
+  EXPECT_GT(result.jump_threshold, 0.0);
+  EXPECT_GE(result.jumps_per_min_generated, 0.0);
+  EXPECT_GE(result.jumps_per_min_stream, 0.0);
+  EXPECT_GE(result.jump_share_at_seams, 0.0);
+  EXPECT_LE(result.jump_share_at_seams, 1.0);
   EXPECT_TRUE(std::isfinite(result.fid));
   ASSERT_EQ(result.fid_by_time_segment.size(), 2u);
   for (double segment_fid : result.fid_by_time_segment) {

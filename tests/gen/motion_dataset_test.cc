@@ -139,6 +139,29 @@ TEST(GenDataset, PlacementDriftAddsUpTheSteps) {
   }
 }
 
+TEST(GenDataset, LargestPoseStepsAreEachFramesFastestKeypoint) {
+  // Two keypoints (x, y each), then the root and log-scale steps, which are
+  // not pose: frame 1 moves keypoint 1 by (3, 4), frame 2 keypoint 0 by
+  // (0, 1) and the root a long way.
+  GenSequence sequence;
+  sequence.num_frames = 3;
+  sequence.features = {0, 0, 0, 0, 0, 0, 0,  //
+                       0, 0, 3, 4, 0, 0, 0,  //
+                       0, 1, 3, 4, 9, 9, 1};
+  const std::vector<double> steps = LargestPoseSteps(sequence, 7);
+  ASSERT_EQ(steps.size(), 2u);
+  EXPECT_DOUBLE_EQ(steps[0], 5.0);
+  EXPECT_DOUBLE_EQ(steps[1], 1.0);
+  // Real walking seen from a view: no frame steps a keypoint by a body
+  // scale (the 99.9th percentile the eval's jumps are counted against).
+  GenViewOptions views;
+  views.num_azimuths = 1;
+  views.elevations_deg = {10};
+  const GenDataset dataset = BuildGenDataset({WalkSource()}, views, 30.0, 4.0);
+  for (double step : LargestPoseSteps(dataset.sequences[0], 37))
+    EXPECT_LT(step, 0.5);
+}
+
 TEST(GenDataset, AnAnchoredPlacementReturnsToItsStart) {
   // A stream whose steps all push one way (log scale +0.001, root +0.01
   // body scales per frame): unanchored it drifts without bound; anchored
