@@ -615,7 +615,7 @@ int RunGenEval(const GenEvalArgs& args) {
   return 0;
 }
 
-// The sampling flags `gen eval` and `generate` share.
+// The sampling and decoding flags `gen eval` and `generate` share.
 void AddGenerationOptions(CLI::App* command, GenerationOptions* generation) {
   SamplingOptions* sampling = &generation->sampling;
   command->add_option("--temperature", sampling->temperature,
