@@ -590,6 +590,7 @@ int RunGenEval(const GenEvalArgs& args) {
         {"jump_threshold", result.jump_threshold},
         {"jumps_per_min_generated", result.jumps_per_min_generated},
         {"jumps_per_min_stream", result.jumps_per_min_stream},
+        {"jumps_per_min_real", result.jumps_per_min_real},
         {"jump_share_at_seams", result.jump_share_at_seams},
         {"diversity_real", result.diversity_real},
         {"diversity_generated", result.diversity_generated},

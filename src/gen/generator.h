@@ -119,12 +119,14 @@ struct GeneratorEvalResult {
   double drift_root_generated = 0.0, drift_root_real = 0.0;
   // Jumps (LargestPoseSteps): frames whose largest keypoint step passes
   // the real data's 99.9th percentile of it (`jump_threshold`, body
-  // scales), per minute, in the generations and in the real codes decoded
-  // as a stream (real motion itself: 0.1 % of its frames, 1.8 a minute at
-  // 30 fps); and the share of the generations' jumps on the first frame of
-  // a decoding (every emit_codes codes: the seams).
+  // scales), per minute, in the generations, in the real codes decoded as
+  // a stream and in the real motion itself (0.1 % of its frames by the
+  // threshold's definition: 1.8 a minute at 30 fps); and the share of the
+  // generations' jumps on the first frame of a decoding (every emit_codes
+  // codes: the seams).
   double jump_threshold = 0.0;
-  double jumps_per_min_generated = 0.0, jumps_per_min_stream = 0.0;
+  double jumps_per_min_generated = 0.0, jumps_per_min_stream = 0.0,
+         jumps_per_min_real = 0.0;
   double jump_share_at_seams = 0.0;
   double realtime_factor = 0.0;  // generated seconds per second of CPU
                                  // time, one LibTorch thread
