@@ -181,7 +181,7 @@ struct StreamDecoding {
   // Each decoding is its own pass, and two passes disagree where they meet:
   // the last code one emits had only the lookahead after it, the next
   // pass's first code has more. Unblended, every seam (each emit_codes
-  // codes) jumps: on the long walks' styles 35-43 frames a minute moved a
+  // codes) jumps: on the long walks' styles 33-41 frames a minute moved a
   // keypoint faster than any frame of their real 2D, all of them at seams
   // (docs/generation.md, "Seams"). Blended, the next pass's first
   // lookahead frames fade in from what the previous pass decoded for them

@@ -226,16 +226,30 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       result.jump_threshold = real_steps[at];
     }
   }
-  auto jumps_per_min = [&](const std::vector<GenSequence>& sequences) {
-    double jumps = 0.0, frames = 0.0;
+  // Jumps per minute of `sequences`, and their share on a frame that
+  // starts a decoding (every `seam_frames`; 0: not counted).
+  struct Jumps {
+    double per_min = 0.0, share_at_seams = 0.0;
+  };
+  auto count_jumps = [&](const std::vector<GenSequence>& sequences,
+                         int seam_frames) {
+    double jumps = 0.0, at_seams = 0.0, frames = 0.0;
     for (const GenSequence& sequence : sequences) {
-      for (double step : LargestPoseSteps(sequence, frame_size))
-        jumps += step > result.jump_threshold;
+      const std::vector<double> steps = LargestPoseSteps(sequence, frame_size);
+      for (size_t i = 0; i < steps.size(); ++i) {
+        if (steps[i] <= result.jump_threshold) continue;
+        ++jumps;
+        // Step i ends at frame i + 1.
+        at_seams += seam_frames > 0 && (i + 1) % seam_frames == 0;
+      }
       frames += sequence.num_frames;
     }
-    return frames > 0 ? jumps / (frames / real.fps / 60.0) : 0.0;
+    Jumps counted;
+    if (frames > 0) counted.per_min = jumps / (frames / real.fps / 60.0);
+    if (jumps > 0) counted.share_at_seams = at_seams / jumps;
+    return counted;
   };
-  result.jumps_per_min_real = jumps_per_min(real.sequences);
+  result.jumps_per_min_real = count_jumps(real.sequences, 0).per_min;
 
   // The streaming decoder alone: the codes the prior learns (every real
   // sequence encoded whole) decoded as a generation's are.
@@ -253,7 +267,7 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
       streamed.push_back({"streamed/" + std::to_string(i),
                           static_cast<int>(frames), std::move(rows)});
     }
-    result.jumps_per_min_stream = jumps_per_min(streamed);
+    result.jumps_per_min_stream = count_jumps(streamed, 0).per_min;
     result.fid_stream_reconstruction = FrechetDistance(
         FitFeatureGaussian(EncodeWindows(encoder, windows_of(streamed))),
         FitFeatureGaussian(real_features));
@@ -343,20 +357,12 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     *log_scale = std::sqrt(scale_sum / count);
     *root = std::sqrt(root_sum / count);
   };
-  result.jumps_per_min_generated = jumps_per_min(generated);
   {
-    const int seam_frames = options.generation.decoding.emit_codes *
-                            tokenizer.model->frames_per_token();
-    double jumps = 0.0, at_seams = 0.0;
-    for (const GenSequence& sequence : generated) {
-      const std::vector<double> steps = LargestPoseSteps(sequence, frame_size);
-      for (size_t i = 0; i < steps.size(); ++i) {
-        if (steps[i] <= result.jump_threshold) continue;
-        ++jumps;
-        at_seams += (i + 1) % seam_frames == 0;  // step i ends at frame i + 1
-      }
-    }
-    result.jump_share_at_seams = jumps > 0 ? at_seams / jumps : 0.0;
+    const Jumps generated_jumps =
+        count_jumps(generated, options.generation.decoding.emit_codes *
+                                   tokenizer.model->frames_per_token());
+    result.jumps_per_min_generated = generated_jumps.per_min;
+    result.jump_share_at_seams = generated_jumps.share_at_seams;
   }
   rms_drift(generated, &result.drift_log_scale_generated,
             &result.drift_root_generated);
