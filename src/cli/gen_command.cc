@@ -551,10 +551,10 @@ struct GenEvalArgs {
 int RunGenEval(const GenEvalArgs& args) {
   const GenConfig config = ReadGeneratorConfig(args.run_dir);
   std::printf(
-      "gen eval %s: %d generations x %.0f s; encoder on %zu held-apart "
-      "motions\n",
+      "gen eval %s: %d generations x %.0f s; %d feature encoder(s) on %zu "
+      "held-apart motions\n",
       args.run_dir.c_str(), args.options.generations, args.options.seconds,
-      args.held_apart.size());
+      args.options.encoders, args.held_apart.size());
   std::fflush(stdout);
   const GenDataset real = LoadGenDataset(config, config.data.motions);
   const GenDataset held_apart = LoadGenDataset(config, args.held_apart);
@@ -611,6 +611,13 @@ int RunGenEval(const GenEvalArgs& args) {
         {"drift_root_generated", result.drift_root_generated},
         {"drift_root_real", result.drift_root_real},
         {"realtime_factor", result.realtime_factor}};
+    json["encoders"] = args.options.encoders;
+    json["encoder_seed"] = args.options.seed;
+    for (const GeneratorFeatureFigures& figures : result.by_encoder) {
+      json["fid_by_encoder"].push_back(figures.fid);
+      json["fid_floor_time_by_encoder"].push_back(figures.fid_floor_time);
+      json["encoder_loss_by_encoder"].push_back(figures.encoder_loss);
+    }
     WriteFileAtomic(args.output, json.dump(2) + "\n");
   }
   return 0;
@@ -695,6 +702,13 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->delimiter(',');
   eval->add_option("--encoder-steps", eval_args->options.encoder_steps,
                    "Training steps of the feature encoder");
+  eval->add_option("--encoders", eval_args->options.encoders,
+                   "Feature encoders trained (seeds --encoder-seed on); "
+                   "every feature figure is their mean")
+      ->check(CLI::PositiveNumber);
+  eval->add_option("--encoder-seed", eval_args->options.seed,
+                   "Seed of the first feature encoder (and of the real "
+                   "stretches the sampled floors draw)");
   eval->add_option("--time-segments", eval_args->options.time_segments,
                    "Also score each generation's k-th part of this many "
                    "alone (drift as the context slides)");

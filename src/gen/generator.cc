@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -86,6 +87,29 @@ std::string GeneratorEvalResult::BriefReport() const {
       << "), halves by view " << fid_floor_views << " (ratio "
       << ratio(fid_floor_views) << "); as many real stretches as generations "
       << fid_floor_sampled << " (ratio " << ratio(fid_floor_sampled) << ")\n"
+      << "feature encoders " << by_encoder.size()
+      << " (every feature figure is their mean); FID / halves-in-time "
+      << "floor by encoder:";
+  double ratio_sum = 0.0, ratio_square_sum = 0.0;
+  for (const GeneratorFeatureFigures& figures : by_encoder) {
+    const double encoder_ratio =
+        figures.fid_floor_time > 0 ? figures.fid / figures.fid_floor_time : 0.0;
+    out << " " << encoder_ratio;
+    ratio_sum += encoder_ratio;
+    ratio_square_sum += encoder_ratio * encoder_ratio;
+  }
+  if (by_encoder.size() > 1) {
+    // The spread of one encoder's ratio, and the standard error of their
+    // mean: how far another set of encoders (or another CPU's) may move it.
+    const double count = static_cast<double>(by_encoder.size());
+    const double mean = ratio_sum / count;
+    const double deviation = std::sqrt(std::max(
+        0.0, (ratio_square_sum - count * mean * mean) / (count - 1.0)));
+    out << " (mean " << mean << ", standard deviation " << deviation
+        << ", standard error of the mean " << deviation / std::sqrt(count)
+        << ")";
+  }
+  out << "\n"
       << "FID of the tokenizer's reconstructions vs real " << fid_reconstruction
       << "; mean |error|: local pose " << reconstruction_pose_error
       << ", root step " << reconstruction_root_error << ", log-scale step "
@@ -124,6 +148,146 @@ std::string GeneratorEvalResult::BriefReport() const {
   return out.str();
 }
 
+namespace {
+
+// Calls f(a.x, b.x) for every scalar figure x of GeneratorFeatureFigures:
+// the one list of them.
+template <typename Figures, typename Other, typename F>
+void ForEachScalarFigure(Figures& a, Other& b, F f) {
+  f(a.encoder_loss, b.encoder_loss);
+  f(a.fid, b.fid);
+  f(a.fid_reconstruction, b.fid_reconstruction);
+  f(a.fid_stream_reconstruction, b.fid_stream_reconstruction);
+  f(a.fid_floor_views, b.fid_floor_views);
+  f(a.fid_floor_time, b.fid_floor_time);
+  f(a.fid_floor_sampled, b.fid_floor_sampled);
+  f(a.fid_floor_sampled_segment, b.fid_floor_sampled_segment);
+  f(a.diversity_real, b.diversity_real);
+  f(a.diversity_generated, b.diversity_generated);
+  f(a.precision, b.precision);
+  f(a.recall, b.recall);
+  f(a.precision_floor_time, b.precision_floor_time);
+  f(a.recall_floor_time, b.recall_floor_time);
+}
+
+// Each figure's mean over the encoders (the lists element by element:
+// every encoder scores the same motions and segments).
+GeneratorFeatureFigures MeanFigures(
+    const std::vector<GeneratorFeatureFigures>& by_encoder) {
+  GeneratorFeatureFigures mean = by_encoder.front();
+  for (size_t e = 1; e < by_encoder.size(); ++e) {
+    const GeneratorFeatureFigures& other = by_encoder[e];
+    ForEachScalarFigure(mean, other,
+                        [](double& sum, double value) { sum += value; });
+    for (size_t m = 0; m < mean.recall_by_motion.size(); ++m)
+      mean.recall_by_motion[m].second += other.recall_by_motion[m].second;
+    for (size_t k = 0; k < mean.fid_by_time_segment.size(); ++k)
+      mean.fid_by_time_segment[k] += other.fid_by_time_segment[k];
+  }
+  const double count = static_cast<double>(by_encoder.size());
+  ForEachScalarFigure(mean, mean,
+                      [count](double& sum, double) { sum /= count; });
+  for (auto& [motion, recall] : mean.recall_by_motion) recall /= count;
+  for (double& segment_fid : mean.fid_by_time_segment) segment_fid /= count;
+  return mean;
+}
+
+using SequenceSet = std::vector<GenSequence>;
+
+// What every encoder scores, prepared once: sequences are windowed as
+// they are scored (the sampled floors' stretches would hold gigabytes of
+// windows at 400 generations).
+struct ScoredSets {
+  torch::Tensor held_apart_windows, real_windows, reconstructed_windows;
+  SequenceSet view_halves[2], time_halves[2];
+  SequenceSet streamed, generated;
+  std::vector<SequenceSet> floor_stretches;          // one set per draw
+  std::vector<SequenceSet> segment_floor_stretches;  // the same, per segment
+  std::vector<SequenceSet> segments;  // the generations' k-th parts
+  std::vector<std::pair<std::string, SequenceSet>> motions;  // those holding
+                                                             // a window
+};
+
+// The feature figures of one encoder, trained with `seed` on the
+// held-apart windows.
+GeneratorFeatureFigures ScoreInFeatures(
+    const ScoredSets& sets, int frame_size,
+    const std::function<torch::Tensor(const SequenceSet&)>& windows_of,
+    const GeneratorEvalOptions& options, uint64_t seed) {
+  GeneratorFeatureFigures figures;
+  FeatureEncoderOptions encoder_options;
+  encoder_options.window_frames = options.window_frames;
+  encoder_options.steps = options.encoder_steps;
+  FeatureEncoder encoder =
+      TrainFeatureEncoder(sets.held_apart_windows, frame_size, encoder_options,
+                          seed, &figures.encoder_loss);
+  auto features_of = [&](const SequenceSet& sequences) {
+    return EncodeWindows(encoder, windows_of(sequences));
+  };
+  auto fid_against = [](const Eigen::MatrixXd& features,
+                        const FeatureGaussian& reference) {
+    return FrechetDistance(FitFeatureGaussian(features), reference);
+  };
+
+  // The real features, and the floors: the real sequences in two halves by
+  // view and in two halves in time; as many real stretches as generations.
+  const Eigen::MatrixXd real_features =
+      EncodeWindows(encoder, sets.real_windows);
+  const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
+  figures.fid_floor_views =
+      fid_against(features_of(sets.view_halves[0]),
+                  FitFeatureGaussian(features_of(sets.view_halves[1])));
+  const Eigen::MatrixXd first_half = features_of(sets.time_halves[0]),
+                        second_half = features_of(sets.time_halves[1]);
+  figures.fid_floor_time =
+      fid_against(first_half, FitFeatureGaussian(second_half));
+  const PrecisionRecall halves =
+      ManifoldPrecisionRecall(first_half, second_half, options.neighbours);
+  figures.precision_floor_time = halves.precision;
+  figures.recall_floor_time = halves.recall;
+  auto sampled_floor = [&](const std::vector<SequenceSet>& draws) {
+    double sum = 0.0;
+    for (const SequenceSet& stretches : draws)
+      sum += fid_against(features_of(stretches), real_gaussian);
+    return draws.empty() ? 0.0 : sum / draws.size();
+  };
+  figures.fid_floor_sampled = sampled_floor(sets.floor_stretches);
+  figures.fid_floor_sampled_segment =
+      sampled_floor(sets.segment_floor_stretches);
+
+  // The tokenizer alone, and the streaming decoder alone.
+  figures.fid_reconstruction = fid_against(
+      EncodeWindows(encoder, sets.reconstructed_windows), real_gaussian);
+  figures.fid_stream_reconstruction =
+      fid_against(features_of(sets.streamed), real_gaussian);
+
+  // The generations: FID, coverage (and each motion's windows alone on the
+  // generated manifold: which motions they leave out), diversity, and each
+  // time segment.
+  const Eigen::MatrixXd generated_features = features_of(sets.generated);
+  figures.fid = fid_against(generated_features, real_gaussian);
+  const PrecisionRecall coverage = ManifoldPrecisionRecall(
+      real_features, generated_features, options.neighbours);
+  figures.precision = coverage.precision;
+  figures.recall = coverage.recall;
+  const Eigen::VectorXd generated_radii =
+      KthNeighbourDistances(generated_features, options.neighbours);
+  for (const auto& [motion, sequences] : sets.motions) {
+    figures.recall_by_motion.push_back(
+        {motion, ShareWithinRadii(features_of(sequences), generated_features,
+                                  generated_radii)});
+  }
+  figures.diversity_real = MeanPairDistance(real_features, 300, options.seed);
+  figures.diversity_generated =
+      MeanPairDistance(generated_features, 300, options.seed);
+  for (const SequenceSet& segment : sets.segments)
+    figures.fid_by_time_segment.push_back(
+        fid_against(features_of(segment), real_gaussian));
+  return figures;
+}
+
+}  // namespace
+
 GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                                       const GenDataset& real,
                                       const GenDataset& held_apart,
@@ -135,6 +299,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     throw ConfigError("gen eval: floor_draws must be at least 1");
   if (options.neighbours < 1)
     throw ConfigError("gen eval: neighbours (k) must be at least 1");
+  if (options.encoders < 1)
+    throw ConfigError("gen eval: encoders must be at least 1");
   if (options.time_segments < 1 || segment_frames < options.window_frames) {
     throw ConfigError(
         "gen eval: " + std::to_string(options.time_segments) +
@@ -145,60 +311,50 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   const std::filesystem::path run(run_dir);
   LoadedTokenizer tokenizer = LoadTokenizer((run / kTokenizerFile).string());
   const int frame_size = real.frame_size;
-  auto windows_of = [&](const std::vector<GenSequence>& sequences) {
-    return DatasetWindows(sequences, frame_size, options.window_frames,
-                          options.stride_frames, tokenizer.mean, tokenizer.std);
-  };
+  const std::function<torch::Tensor(const SequenceSet&)> windows_of =
+      [&](const SequenceSet& sequences) {
+        return DatasetWindows(sequences, frame_size, options.window_frames,
+                              options.stride_frames, tokenizer.mean,
+                              tokenizer.std);
+      };
   GeneratorEvalResult result;
+  ScoredSets sets;
 
-  // 1. The encoder, trained on motion the generator never saw.
-  const torch::Tensor held_windows = windows_of(held_apart.sequences);
-  result.held_apart_windows = static_cast<int>(held_windows.size(0));
-  FeatureEncoderOptions encoder_options;
-  encoder_options.window_frames = options.window_frames;
-  encoder_options.steps = options.encoder_steps;
-  FeatureEncoder encoder =
-      TrainFeatureEncoder(held_windows, frame_size, encoder_options,
-                          options.seed, &result.encoder_loss);
-
-  // 2. Real features, and the floors: the real sequences in two halves by
-  // view, and in two halves in time.
-  const torch::Tensor real_windows = windows_of(real.sequences);
-  result.real_windows = static_cast<int>(real_windows.size(0));
-  const Eigen::MatrixXd real_features = EncodeWindows(encoder, real_windows);
-  auto features_of = [&](const std::vector<GenSequence>& sequences) {
-    return EncodeWindows(encoder, windows_of(sequences));
-  };
+  // 1. The real and the held-apart windows; the real sequences in two
+  // halves by view and in two halves in time; each motion's sequences.
+  sets.held_apart_windows = windows_of(held_apart.sequences);
+  result.held_apart_windows = static_cast<int>(sets.held_apart_windows.size(0));
+  sets.real_windows = windows_of(real.sequences);
+  result.real_windows = static_cast<int>(sets.real_windows.size(0));
+  for (size_t i = 0; i < real.sequences.size(); ++i)
+    sets.view_halves[i % 2].push_back(real.sequences[i]);
+  for (const GenSequence& sequence : real.sequences) {
+    auto [first, second] = SplitSequenceInTime(sequence, frame_size);
+    sets.time_halves[0].push_back(std::move(first));
+    sets.time_halves[1].push_back(std::move(second));
+  }
   {
-    std::vector<GenSequence> by_view[2], by_time[2];
-    for (size_t i = 0; i < real.sequences.size(); ++i)
-      by_view[i % 2].push_back(real.sequences[i]);
-    for (const GenSequence& sequence : real.sequences) {
-      const auto [first, second] = SplitSequenceInTime(sequence, frame_size);
-      by_time[0].push_back(first);
-      by_time[1].push_back(second);
+    std::map<std::string, SequenceSet> by_motion;
+    for (const GenSequence& sequence : real.sequences)
+      by_motion[sequence.name.substr(0, sequence.name.find('/'))].push_back(
+          sequence);
+    for (auto& [motion, sequences] : by_motion) {
+      bool has_window = false;
+      for (const GenSequence& sequence : sequences)
+        has_window |= sequence.num_frames >= options.window_frames;
+      if (has_window) sets.motions.push_back({motion, std::move(sequences)});
     }
-    result.fid_floor_views =
-        FrechetDistance(FitFeatureGaussian(features_of(by_view[0])),
-                        FitFeatureGaussian(features_of(by_view[1])));
-    const Eigen::MatrixXd first_half = features_of(by_time[0]),
-                          second_half = features_of(by_time[1]);
-    result.fid_floor_time = FrechetDistance(FitFeatureGaussian(first_half),
-                                            FitFeatureGaussian(second_half));
-    const PrecisionRecall halves =
-        ManifoldPrecisionRecall(first_half, second_half, options.neighbours);
-    result.precision_floor_time = halves.precision;
-    result.recall_floor_time = halves.recall;
   }
 
-  // The tokenizer alone: every real window encoded and decoded (windows
+  // 2. The tokenizer alone: every real window encoded and decoded (windows
   // of the length it was trained on; decoding whole sequences at once was
   // 3x worse on the local pose: the network leans on the windows' edges).
   {
     torch::NoGradGuard no_grad;
-    const torch::Tensor decoded =
-        tokenizer.model->Decode(tokenizer.model->Encode(real_windows));
-    const torch::Tensor error = (decoded - real_windows).abs() * tokenizer.std;
+    sets.reconstructed_windows =
+        tokenizer.model->Decode(tokenizer.model->Encode(sets.real_windows));
+    const torch::Tensor error =
+        (sets.reconstructed_windows - sets.real_windows).abs() * tokenizer.std;
     const int pose = RootStepColumn(frame_size);  // the local pose before it
     result.reconstruction_pose_error =
         error.narrow(2, 0, pose).mean().item<double>();
@@ -206,9 +362,6 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
         error.narrow(2, pose, 2).mean().item<double>();
     result.reconstruction_scale_error =
         error.narrow(2, pose + 2, 1).mean().item<double>();
-    result.fid_reconstruction =
-        FrechetDistance(FitFeatureGaussian(EncodeWindows(encoder, decoded)),
-                        FitFeatureGaussian(real_features));
   }
 
   // Jumps: the real data's 99.9th percentile of the largest keypoint step
@@ -231,8 +384,7 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   struct Jumps {
     double per_min = 0.0, share_at_seams = 0.0;
   };
-  auto count_jumps = [&](const std::vector<GenSequence>& sequences,
-                         int seam_frames) {
+  auto count_jumps = [&](const SequenceSet& sequences, int seam_frames) {
     double jumps = 0.0, at_seams = 0.0, frames = 0.0;
     for (const GenSequence& sequence : sequences) {
       const std::vector<double> steps = LargestPoseSteps(sequence, frame_size);
@@ -257,50 +409,39 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     std::vector<int> kept;
     const std::vector<std::vector<int64_t>> code_sequences = TokenizeDataset(
         tokenizer.model, real, tokenizer.mean, tokenizer.std, &kept);
-    std::vector<GenSequence> streamed;
     for (size_t i = 0; i < code_sequences.size(); ++i) {
       MotionStream stream(tokenizer, code_sequences[i], options.generation);
       const int64_t frames = stream.frames_available();
       std::vector<float> rows;
       while (static_cast<int64_t>(rows.size()) < frames * frame_size)
         stream.Next(&rows);
-      streamed.push_back({"streamed/" + std::to_string(i),
-                          static_cast<int>(frames), std::move(rows)});
+      sets.streamed.push_back({"streamed/" + std::to_string(i),
+                               static_cast<int>(frames), std::move(rows)});
     }
-    result.jumps_per_min_stream = count_jumps(streamed, 0).per_min;
-    result.fid_stream_reconstruction = FrechetDistance(
-        FitFeatureGaussian(EncodeWindows(encoder, windows_of(streamed))),
-        FitFeatureGaussian(real_features));
+    result.jumps_per_min_stream = count_jumps(sets.streamed, 0).per_min;
   }
 
   // The floors at the generations' sample size: as many real stretches as
-  // generations, as long as a generation (and as a segment), scored alike.
-  const FeatureGaussian real_gaussian = FitFeatureGaussian(real_features);
-  auto sampled_floor = [&](int stretch_frames) {
-    double sum = 0.0;
-    for (int d = 0; d < options.floor_draws; ++d) {
-      // Among the sequences that hold a window, as the real windows are (a
-      // once-played kick of 46 frames holds none).
-      const std::vector<GenSequence> stretches = DrawRealStretches(
-          real.sequences, frame_size, stretch_frames, options.generations,
-          options.window_frames, options.seed + 1000 + d);
-      sum += FrechetDistance(
-          FitFeatureGaussian(EncodeWindows(encoder, windows_of(stretches))),
-          real_gaussian);
-    }
-    return sum / options.floor_draws;
-  };
+  // generations, as long as a generation (and as a segment), drawn among
+  // the sequences that hold a window, as the real windows are (a
+  // once-played kick of 46 frames holds none).
   const int generation_frames =
       static_cast<int>(std::lround(options.seconds * real.fps));
-  result.fid_floor_sampled = sampled_floor(generation_frames);
-  if (options.time_segments > 1) {
-    result.fid_floor_sampled_segment = sampled_floor(segment_frames);
+  for (int d = 0; d < options.floor_draws; ++d) {
+    const uint64_t draw_seed = options.seed + 1000 + d;
+    sets.floor_stretches.push_back(DrawRealStretches(
+        real.sequences, frame_size, generation_frames, options.generations,
+        options.window_frames, draw_seed));
+    if (options.time_segments > 1) {
+      sets.segment_floor_stretches.push_back(DrawRealStretches(
+          real.sequences, frame_size, segment_frames, options.generations,
+          options.window_frames, draw_seed));
+    }
   }
 
-  // 3. Generated features; generation timed on one thread.
+  // 3. The generations, timed on one thread.
   const int threads = torch::get_num_threads();
   torch::set_num_threads(1);
-  std::vector<GenSequence> generated;
   double generation_s = 0.0, generated_s = 0.0;
   CheckGeneration(options.seconds, options.generation.sampling);
   const LoadedPrior prior = LoadPrior((run / kPriorFile).string());
@@ -334,19 +475,33 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
         Generate(tokenizer, prior, options.seconds, generation);
     generation_s += motion.generation_s;
     generated_s += motion.num_frames / motion.fps;
-    generated.push_back({"generated/" + std::to_string(g + 1),
-                         motion.num_frames, std::move(motion.rows)});
+    sets.generated.push_back({"generated/" + std::to_string(g + 1),
+                              motion.num_frames, std::move(motion.rows)});
   }
   torch::set_num_threads(threads);
   result.realtime_factor = generated_s / std::max(1e-9, generation_s);
-  const torch::Tensor generated_windows = windows_of(generated);
-  result.generated_windows = static_cast<int>(generated_windows.size(0));
-  const Eigen::MatrixXd generated_features =
-      EncodeWindows(encoder, generated_windows);
+  result.generated_windows =
+      static_cast<int>(windows_of(sets.generated).size(0));
+  if (options.time_segments > 1) {
+    sets.segments.resize(options.time_segments);
+    for (const GenSequence& sequence : sets.generated) {
+      SequenceSet parts =
+          CutSequenceInTime(sequence, frame_size, options.time_segments);
+      for (int k = 0; k < options.time_segments; ++k)
+        sets.segments[k].push_back(std::move(parts[k]));
+    }
+  }
 
-  // 4. The figures.
-  auto rms_drift = [&](const std::vector<GenSequence>& sequences,
-                       double* log_scale, double* root) {
+  // The figures that need no features: jumps and placement drift.
+  {
+    const Jumps generated_jumps =
+        count_jumps(sets.generated, options.generation.decoding.emit_codes *
+                                        tokenizer.model->frames_per_token());
+    result.jumps_per_min_generated = generated_jumps.per_min;
+    result.jump_share_at_seams = generated_jumps.share_at_seams;
+  }
+  auto rms_drift = [&](const SequenceSet& sequences, double* log_scale,
+                       double* root) {
     double scale_sum = 0.0, root_sum = 0.0;
     for (const GenSequence& sequence : sequences) {
       const PlacementDrift drift = PlacementDriftOf(sequence, frame_size);
@@ -357,61 +512,18 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
     *log_scale = std::sqrt(scale_sum / count);
     *root = std::sqrt(root_sum / count);
   };
-  {
-    const Jumps generated_jumps =
-        count_jumps(generated, options.generation.decoding.emit_codes *
-                                   tokenizer.model->frames_per_token());
-    result.jumps_per_min_generated = generated_jumps.per_min;
-    result.jump_share_at_seams = generated_jumps.share_at_seams;
-  }
-  rms_drift(generated, &result.drift_log_scale_generated,
+  rms_drift(sets.generated, &result.drift_log_scale_generated,
             &result.drift_root_generated);
-  rms_drift(DrawRealStretches(real.sequences, frame_size, generation_frames,
-                              options.generations, options.window_frames,
-                              options.seed + 1000),
-            &result.drift_log_scale_real, &result.drift_root_real);
-  result.fid =
-      FrechetDistance(FitFeatureGaussian(generated_features), real_gaussian);
-  const PrecisionRecall coverage = ManifoldPrecisionRecall(
-      real_features, generated_features, options.neighbours);
-  result.precision = coverage.precision;
-  result.recall = coverage.recall;
-  {
-    // Each motion's windows alone on the generated manifold: which motions
-    // the generations leave out.
-    const Eigen::VectorXd generated_radii =
-        KthNeighbourDistances(generated_features, options.neighbours);
-    std::map<std::string, std::vector<GenSequence>> by_motion;
-    for (const GenSequence& sequence : real.sequences)
-      by_motion[sequence.name.substr(0, sequence.name.find('/'))].push_back(
-          sequence);
-    for (const auto& [motion, sequences] : by_motion) {
-      bool has_window = false;
-      for (const GenSequence& sequence : sequences)
-        has_window |= sequence.num_frames >= options.window_frames;
-      if (!has_window) continue;
-      result.recall_by_motion.push_back(
-          {motion, ShareWithinRadii(features_of(sequences), generated_features,
-                                    generated_radii)});
-    }
+  rms_drift(sets.floor_stretches.front(), &result.drift_log_scale_real,
+            &result.drift_root_real);
+
+  // 4. The figures in each encoder's features, and their means.
+  for (int e = 0; e < options.encoders; ++e) {
+    result.by_encoder.push_back(ScoreInFeatures(sets, frame_size, windows_of,
+                                                options, options.seed + e));
   }
-  result.diversity_real = MeanPairDistance(real_features, 300, options.seed);
-  result.diversity_generated =
-      MeanPairDistance(generated_features, 300, options.seed);
-  if (options.time_segments > 1) {
-    std::vector<std::vector<GenSequence>> segments(options.time_segments);
-    for (const GenSequence& sequence : generated) {
-      std::vector<GenSequence> parts =
-          CutSequenceInTime(sequence, frame_size, options.time_segments);
-      for (int k = 0; k < options.time_segments; ++k)
-        segments[k].push_back(std::move(parts[k]));
-    }
-    for (const std::vector<GenSequence>& segment : segments) {
-      result.fid_by_time_segment.push_back(FrechetDistance(
-          FitFeatureGaussian(EncodeWindows(encoder, windows_of(segment))),
-          real_gaussian));
-    }
-  }
+  static_cast<GeneratorFeatureFigures&>(result) =
+      MeanFigures(result.by_encoder);
   return result;
 }
 

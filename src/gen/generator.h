@@ -56,7 +56,14 @@ struct GeneratorEvalOptions {
   int window_frames = 64;        // feature windows
   int stride_frames = 16;
   int64_t encoder_steps = 3000;
-  uint64_t seed = 1;  // encoder initialization and batches
+  // Feature encoders trained, seeds seed, seed + 1, ...; every feature
+  // figure is the mean over them. One encoder's figures move with how it
+  // happened to train: the same seed on another CPU's kernels trains
+  // another encoder, and the FID's ratio to its floor moved 1.79 -> 2.06
+  // between two machines, and between five seeds on one machine over 100
+  // generations from 1.70 to 2.20 (docs/generation.md, section 5).
+  int encoders = 5;
+  uint64_t seed = 1;  // the first encoder's initialization and batches
   // Each generation is also cut into this many equal parts in time, and
   // the windows of each part scored alone: a prior that drifts away from
   // the data as its context slides scores worse in the later parts.
@@ -66,8 +73,8 @@ struct GeneratorEvalOptions {
   int neighbours = 3;  // k of precision and recall (the paper's default)
 };
 
-struct GeneratorEvalResult {
-  int real_windows = 0, held_apart_windows = 0, generated_windows = 0;
+// The figures read in a feature encoder's features: one set per encoder.
+struct GeneratorFeatureFigures {
   double encoder_loss = 0.0;  // reconstruction MSE at the end
   double fid = 0.0;           // generated vs real
   // The tokenizer alone: every real window encoded and decoded.
@@ -77,9 +84,6 @@ struct GeneratorEvalResult {
   // (MotionStream's replay; options.generation's decoding and anchor). The
   // floor a perfect prior's generations would score.
   double fid_stream_reconstruction = 0.0;
-  // Its mean |error| per channel group of X^can (body-scale units).
-  double reconstruction_pose_error = 0.0, reconstruction_root_error = 0.0,
-         reconstruction_scale_error = 0.0;
   // Real vs real, two floors: the sequences' views in two halves
   // (alternating; every motion and frame in both: how far the features
   // move with the view alone) and every sequence cut in two in time (every
@@ -110,6 +114,17 @@ struct GeneratorEvalResult {
   // part of every generation; equal window counts, so comparable with each
   // other, not with `fid`, which has more windows and less bias).
   std::vector<double> fid_by_time_segment;
+};
+
+// The figures of `gen eval`: the feature figures (the base) are the means
+// over the encoders, `by_encoder` each encoder's own.
+struct GeneratorEvalResult : GeneratorFeatureFigures {
+  int real_windows = 0, held_apart_windows = 0, generated_windows = 0;
+  std::vector<GeneratorFeatureFigures> by_encoder;
+  // The tokenizer's reconstructions of the real windows: mean |error| per
+  // channel group of X^can (body-scale units).
+  double reconstruction_pose_error = 0.0, reconstruction_root_error = 0.0,
+         reconstruction_scale_error = 0.0;
   // Placement drift over a generation (PlacementDriftOf), root mean square
   // over the generations, and over as many real stretches of the same
   // length: the change of log scale, and the root's displacement (units of
@@ -135,10 +150,13 @@ struct GeneratorEvalResult {
 
 // Outline: the real windows (the generator's own dataset, rebuilt from its
 // config) and the held-apart windows (`held_apart`: motions it never saw)
-// in the tokenizer's normalization; an encoder trained on the held-apart
-// windows; features of the real windows, of two pairs of halves of them
-// (by view and by time) and of `generations` generated streams; FIDs and
-// diversities. `run_dir` holds tokenizer.pt and prior.pt.
+// in the tokenizer's normalization; the tokenizer's reconstructions, the
+// real codes decoded as a stream and `generations` generated streams; then
+// for each of `encoders` encoders trained on the held-apart windows, the
+// features of the real windows, of two pairs of halves of them (by view
+// and by time), of the reconstructions and of the generations, and from
+// them FIDs, coverage and diversities; their means. `run_dir` holds
+// tokenizer.pt and prior.pt.
 GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
                                       const GenDataset& real,
                                       const GenDataset& held_apart,

@@ -52,6 +52,7 @@ GeneratorEvalOptions TinyEvalOptions(double seconds, int time_segments) {
   options.window_frames = 16;
   options.stride_frames = 8;
   options.encoder_steps = 20;
+  options.encoders = 2;
   options.time_segments = time_segments;
   return options;
 }
@@ -335,6 +336,31 @@ TEST(GenTrainer, TheTrainedGeneratorIsMeasured) {
   const GeneratorEvalResult result =
       EvaluateGenerator(config.run.run_dir, walk, walk, options);
   EXPECT_EQ(result.generated_windows, 2 * ((90 - 16) / 8 + 1));
+  // Two encoders: every feature figure is their mean, and the first one's
+  // figures are what it scores alone.
+  ASSERT_EQ(result.by_encoder.size(), 2u);
+  EXPECT_NEAR(result.fid,
+              0.5 * (result.by_encoder[0].fid + result.by_encoder[1].fid),
+              1e-9 * (1.0 + result.fid));
+  EXPECT_NEAR(result.fid_floor_time,
+              0.5 * (result.by_encoder[0].fid_floor_time +
+                     result.by_encoder[1].fid_floor_time),
+              1e-9 * (1.0 + result.fid_floor_time));
+  EXPECT_NE(result.by_encoder[0].fid, result.by_encoder[1].fid);
+  {
+    GeneratorEvalOptions alone = options;
+    alone.encoders = 1;
+    const GeneratorEvalResult single =
+        EvaluateGenerator(config.run.run_dir, walk, walk, alone);
+    ASSERT_EQ(single.by_encoder.size(), 1u);
+    EXPECT_DOUBLE_EQ(single.fid, result.by_encoder[0].fid);
+    EXPECT_DOUBLE_EQ(single.fid_floor_time,
+                     result.by_encoder[0].fid_floor_time);
+    ASSERT_EQ(single.recall_by_motion.size(), result.recall_by_motion.size());
+    alone.encoders = 0;
+    EXPECT_THROW(EvaluateGenerator(config.run.run_dir, walk, walk, alone),
+                 ConfigError);
+  }
   EXPECT_GT(result.real_windows, 0);
   EXPECT_GE(result.fid, 0.0);
   EXPECT_GE(result.fid_floor_views, 0.0);
