@@ -217,6 +217,41 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
 // A prior conditioned on the motion: `generate --policy --each-motion`
 // spreads the tracked generations over the config's motions (generation g
 // draws motion g mod their number) and names each stream's motion.
+TEST(Cli, GenEvalReadsItsFiguresInSeveralEncoders) {
+  // `gen eval --encoders 2`: each encoder's FID and floor in the JSON, the
+  // FID their mean, each one's ratio printed; no encoder is refused.
+  const std::string dir = testing::TempDir("cli_gen_eval");
+  const std::string config = WriteTinyGenConfig(
+      dir, testing::SourcePath("assets/motions/deepmimic/humanoid3d_walk.txt"),
+      "");
+  // Real sequences of 6 s: their halves in time hold a 64-frame window.
+  std::string text = ReadFileText(config);
+  text.replace(text.find("loop_to_s: 4"), 12, "loop_to_s: 6");
+  WriteFileAtomic(config, text);
+  CommandResult result = RunMimic2d("gen train " + config);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::string json_path = dir + "/eval.json";
+  const std::string eval = "gen eval " + dir +
+                           "/gen --generations 2 --seconds 4 "
+                           "--encoder-steps 10 --time-segments 1 ";
+  result = RunMimic2d(eval + "--encoders 2 -o " + json_path);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("feature encoders 2"), std::string::npos)
+      << result.output;
+  const nlohmann::json figures = ReadJsonFile(json_path);
+  ASSERT_EQ(figures.at("fid_by_encoder").size(), 2u);
+  ASSERT_EQ(figures.at("fid_floor_time_by_encoder").size(), 2u);
+  EXPECT_EQ(figures.at("encoders"), 2);
+  EXPECT_NEAR(figures.at("fid").get<double>(),
+              0.5 * (figures.at("fid_by_encoder")[0].get<double>() +
+                     figures.at("fid_by_encoder")[1].get<double>()),
+              1e-9);
+  result = RunMimic2d(eval + "--encoders 0");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--encoders"), std::string::npos)
+      << result.output;
+}
+
 TEST(Cli, GenerateEachMotionSpreadsTrackedStreamsOverTheMotions) {
   const std::string dir = testing::TempDir("cli_generate_each_motion");
   const std::string config = WriteTinyGenConfig(
