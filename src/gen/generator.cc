@@ -194,11 +194,12 @@ GeneratorFeatureFigures MeanFigures(
 
 using SequenceSet = std::vector<GenSequence>;
 
-// What every encoder scores, prepared once: sequences are windowed as
-// they are scored (the sampled floors' stretches would hold gigabytes of
-// windows at 400 generations).
+// What every encoder scores, prepared once: the real and generated
+// windows, and sets of sequences windowed as they are scored (the sampled
+// floors' stretches would hold gigabytes of windows at 400 generations).
 struct ScoredSets {
-  torch::Tensor held_apart_windows, real_windows, reconstructed_windows;
+  torch::Tensor held_apart_windows, real_windows, reconstructed_windows,
+      generated_windows;
   SequenceSet view_halves[2], time_halves[2];
   SequenceSet streamed, generated;
   std::vector<SequenceSet> floor_stretches;          // one set per draw
@@ -264,7 +265,8 @@ GeneratorFeatureFigures ScoreInFeatures(
   // The generations: FID, coverage (and each motion's windows alone on the
   // generated manifold: which motions they leave out), diversity, and each
   // time segment.
-  const Eigen::MatrixXd generated_features = features_of(sets.generated);
+  const Eigen::MatrixXd generated_features =
+      EncodeWindows(encoder, sets.generated_windows);
   figures.fid = fid_against(generated_features, real_gaussian);
   // ManifoldPrecisionRecall's two shares, the generated radii found once
   // (the longest step at 400 generations) for the recall by motion too.
@@ -483,8 +485,8 @@ GeneratorEvalResult EvaluateGenerator(const std::string& run_dir,
   }
   torch::set_num_threads(threads);
   result.realtime_factor = generated_s / std::max(1e-9, generation_s);
-  result.generated_windows =
-      static_cast<int>(windows_of(sets.generated).size(0));
+  sets.generated_windows = windows_of(sets.generated);
+  result.generated_windows = static_cast<int>(sets.generated_windows.size(0));
   if (options.time_segments > 1) {
     sets.segments.resize(options.time_segments);
     for (const GenSequence& sequence : sets.generated) {
