@@ -152,6 +152,7 @@ struct GenerateArgs {
   int generations = 1;
   std::vector<double> azimuths_deg;  // with --policy: views (default --view's)
   std::string video;
+  std::string frames_csv;  // with --policy: every rollout's per-frame errors
   // With --policy: where each rollout starts and which camera it is seen by.
   GeneratedStart start = GeneratedStart::kFit;
   double start_fit_s = 2.0;  // with kFit: the stream's first seconds fitted
@@ -314,6 +315,22 @@ std::vector<TrackedSource> TrackedSources(const GenerateArgs& args) {
   return sources;
 }
 
+// A CSV field: quoted, with inner quotes doubled (labels hold commas).
+std::string CsvQuoted(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text)
+    quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// How a streamed rollout ended, for --frames: early_exit, diverged,
+// time_limit (--seconds tracked) or stream_end (the stream ran out).
+const char* StreamedRolloutEnd(const StreamedRollout& rollout, int max_steps) {
+  if (rollout.diverged()) return "diverged";
+  if (rollout.stats().failed) return "early_exit";
+  return rollout.stats().steps >= max_steps ? "time_limit" : "stream_end";
+}
+
 // The checkpoint's tracker along every stream of TrackedSources. Each
 // starts where args.start says (by default the fit of the stream's first
 // seconds: its first pose, seen by its first camera); the camera then
@@ -371,7 +388,14 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   }
   int succeeded = 0, rollouts = 0, unfitted = 0;
   double e2d_sum_px = 0.0;
+  // --frames: a row per tracked frame of every rollout.
+  const std::vector<std::string>& keypoint_names =
+      character->keypoint_layout().keypoint_names;
+  std::string frames_csv =
+      "stream,label,start_frame,step,frame,keypoints_present,mean_px,"
+      "worst_px,worst_keypoint,end\n";
   for (const TrackedSource& source : sources) {
+    const int stream_index = static_cast<int>(&source - sources.data());
     // The start, its frame and the first camera.
     SimState start;
     int start_frame = 0;
@@ -436,9 +460,31 @@ int RunTrackedGenerations(const GenerateArgs& args) {
       frames.push_back(std::move(frame));
     };
     record();
+    // One CSV row for the step just taken (`last`: the rollout's end).
+    auto record_frame = [&](bool last) {
+      if (args.frames_csv.empty()) return;
+      const ReprojectionError& error = rollout.last_error();
+      char numbers[128];
+      std::snprintf(numbers, sizeof(numbers), ",%d,%d,%d,%d,%.2f,%.2f,",
+                    start_frame, rollout.stats().steps, rollout.frame(),
+                    error.num_present, error.mean_px, error.max_px);
+      const bool named =
+          error.worst_keypoint >= 0 &&
+          error.worst_keypoint < static_cast<int>(keypoint_names.size());
+      frames_csv +=
+          std::to_string(stream_index) + "," + CsvQuoted(source.label) +
+          numbers + (named ? keypoint_names[error.worst_keypoint] : "") + "," +
+          (last ? StreamedRolloutEnd(rollout, env_options.max_episode_steps())
+                : "") +
+          "\n";
+    };
     const auto started = std::chrono::steady_clock::now();
-    while (rollout.Step(policy)) record();
+    while (rollout.Step(policy)) {
+      record();
+      record_frame(false);
+    }
     record();
+    if (rollout.stats().steps > 0) record_frame(true);
     const double wall_s = std::chrono::duration<double>(
                               std::chrono::steady_clock::now() - started)
                               .count();
@@ -476,6 +522,10 @@ int RunTrackedGenerations(const GenerateArgs& args) {
               rollouts > 0 ? e2d_sum_px / rollouts : 0.0);
   if (unfitted > 0) std::printf(", %d not started (fit failed)", unfitted);
   std::printf("\n");
+  if (!args.frames_csv.empty()) {
+    WriteFileAtomic(args.frames_csv, frames_csv);
+    std::printf("wrote %s (per-frame errors)\n", args.frames_csv.c_str());
+  }
   return 0;
 }
 
@@ -483,10 +533,11 @@ int RunGenerate(const GenerateArgs& args) {
   if (args.view.size() != 3)
     throw ConfigError("generate: --view takes azimuth,elevation,distance");
   if (args.policy.empty() &&
-      (!args.video.empty() || args.generations != 1 ||
-       !args.azimuths_deg.empty() || !args.real.empty() || args.each_motion))
+      (!args.video.empty() || !args.frames_csv.empty() ||
+       args.generations != 1 || !args.azimuths_deg.empty() ||
+       !args.real.empty() || args.each_motion))
     throw ConfigError(
-        "generate: --video, --generations, --azimuths, --real and "
+        "generate: --video, --frames, --generations, --azimuths, --real and "
         "--each-motion need --policy");
   if (args.start_at_s >= 0.0 && args.start != GeneratedStart::kFit)
     throw ConfigError(
@@ -770,6 +821,12 @@ void AddGenCommands(CLI::App& app, CommandRun* run) {
       ->delimiter(',');
   generate->add_option("--video", generate_args->video,
                        "With --policy: the first tracked stream drawn (MP4)");
+  generate
+      ->add_option("--frames", generate_args->frames_csv,
+                   "With --policy: every rollout's per-frame errors as CSV "
+                   "(mean and worst keypoint in px, which keypoint, how the "
+                   "rollout ended): where a stream starts to fail")
+      ->check(WritableFile());
   generate
       ->add_option("--start", generate_args->start,
                    "With --policy: fit (the fit of each stream's first "

@@ -136,6 +136,8 @@ bool StreamedRollout::Step(Policy& policy) {
     stats_.sum_mean_error_px += outcome.error.mean_px;
   }
   stats_.max_error_px = std::max(stats_.max_error_px, outcome.error.max_px);
+  last_error_ = outcome.error;
+  diverged_ = outcome.diverged;
   ++frame_;
   window_.pop_front();
   cameras_.pop_front();

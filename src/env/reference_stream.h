@@ -78,6 +78,10 @@ class StreamedRollout {
   // The rollout's counts over the whole stream (view_index and
   // start_frame 0).
   const EpisodeStats& stats() const { return stats_; }
+  // The last step's error against the frame it reached, and whether that
+  // step diverged (for per-frame records: where a stream starts to fail).
+  const ReprojectionError& last_error() const { return last_error_; }
+  bool diverged() const { return diverged_; }
   const Simulation& simulation() const { return env_->simulation(); }
   // The current frame's reference keypoints and camera, for drawing.
   const std::vector<Keypoint2D>& reference_frame() const;
@@ -102,8 +106,10 @@ class StreamedRollout {
   std::deque<PinholeCamera> cameras_;
   bool stream_ended_ = false;
   bool ended_ = false;
+  bool diverged_ = false;
   int frame_ = 0;
   EpisodeStats stats_;
+  ReprojectionError last_error_;
   std::vector<float> observation_, action_;
   SimState state_;
 };

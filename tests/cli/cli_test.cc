@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -119,8 +121,47 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
   result =
       RunMimic2d("generate " + dir + "/gen --seconds 2 --policy " + policy +
                  " --generations 2 --azimuths 30,120 --start-fit-s 1 --video " +
-                 dir + "/tracked.mp4 -o " + dir + "/generated.json");
+                 dir + "/tracked.mp4 --frames " + dir + "/frames.csv -o " +
+                 dir + "/generated.json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
+  // --frames: a row per tracked frame of each of the 4 rollouts, as many
+  // as its line says it tracked, the last naming how it ended.
+  {
+    std::ifstream csv(dir + "/frames.csv");
+    std::string line;
+    ASSERT_TRUE(std::getline(csv, line)) << "no " << dir << "/frames.csv";
+    EXPECT_EQ(line,
+              "stream,label,start_frame,step,frame,keypoints_present,mean_px,"
+              "worst_px,worst_keypoint,end");
+    std::map<int, int> rows_by_stream;
+    std::map<int, std::string> last_row_by_stream;
+    while (std::getline(csv, line)) {
+      const int stream = std::stoi(line.substr(0, line.find(',')));
+      ++rows_by_stream[stream];
+      last_row_by_stream[stream] = line;
+      // The label is quoted (it holds commas).
+      EXPECT_NE(line.find(",\"azimuth "), std::string::npos) << line;
+    }
+    ASSERT_EQ(rows_by_stream.size(), 4u);
+    int tracked_frames = 0;
+    for (size_t at = result.output.find(" after "); at != std::string::npos;
+         at = result.output.find(" after ", at + 1)) {
+      if (std::isdigit(static_cast<unsigned char>(result.output[at + 7])))
+        tracked_frames += std::stoi(result.output.substr(at + 7));
+    }
+    int rows = 0;
+    for (const auto& [stream, count] : rows_by_stream) rows += count;
+    EXPECT_EQ(rows, tracked_frames) << result.output;
+    for (const auto& [stream, row] : last_row_by_stream) {
+      const std::string end = row.substr(row.rfind(',') + 1);
+      EXPECT_TRUE(end == "time_limit" || end == "early_exit" ||
+                  end == "stream_end" || end == "diverged")
+          << row;
+    }
+  }
+  EXPECT_NE(result.output.find("wrote " + dir + "/frames.csv"),
+            std::string::npos)
+      << result.output;
   EXPECT_NE(result.output.find("azimuth 120 deg, generation 2 (seed 2): "),
             std::string::npos)
       << result.output;

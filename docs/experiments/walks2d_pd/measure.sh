@@ -13,7 +13,8 @@
 # defaults, as every figure before 2026-12-05 was measured).
 # DRAWS: how many draws of the 18 streams (default 1: seeds 1-9, as every
 # figure before 2026-12-06's sixth session; draw d uses seeds 9d+1...9d+9,
-# logged as OUT_PREFIX_generated[_d].log). One draw moves the count by 2-3.
+# logged as OUT_PREFIX_generated[_d].log, every rollout's per-frame errors in
+# OUT_PREFIX_frames[_d].csv). One draw moves the count by 2-3.
 # START_FIT_S, START_AT_S: generate's --start-fit-s (the stream's first
 # seconds fitted, default 2) and --start-at-s (where the rollout starts,
 # default the middle of the fitted seconds); figures before 2026-12-07 are
@@ -35,6 +36,7 @@ for ((draw = 0; draw < ${DRAWS:-1}; ++draw)); do
   build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
     "${start_options[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
     --seed $((9 * draw + 1)) -o "${out}_generated${suffix}.json" \
+    --frames "${out}_frames${suffix}.csv" \
     > "${out}_generated${suffix}.log" 2>&1
   grep -E "generation|^Succ" "${out}_generated${suffix}.log"
 done
