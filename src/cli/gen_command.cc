@@ -323,12 +323,13 @@ std::string CsvQuoted(const std::string& text) {
   return quoted + "\"";
 }
 
-// How a streamed rollout ended, for --frames: early_exit, diverged,
-// time_limit (--seconds tracked) or stream_end (the stream ran out).
-const char* StreamedRolloutEnd(const StreamedRollout& rollout, int max_steps) {
-  if (rollout.diverged()) return "diverged";
-  if (rollout.stats().failed) return "early_exit";
-  return rollout.stats().steps >= max_steps ? "time_limit" : "stream_end";
+// How a streamed rollout ended, in eval --frames' words: the stream
+// running out is its clip's end; --seconds tracked, the time limit.
+RolloutEnd StreamedRolloutEnd(const StreamedRollout& rollout, int max_steps) {
+  if (rollout.diverged()) return RolloutEnd::kDiverged;
+  if (rollout.stats().failed) return RolloutEnd::kEarlyExit;
+  return rollout.stats().steps >= max_steps ? RolloutEnd::kTimeLimit
+                                            : RolloutEnd::kClipEnd;
 }
 
 // The checkpoint's tracker along every stream of TrackedSources. Each
@@ -461,6 +462,7 @@ int RunTrackedGenerations(const GenerateArgs& args) {
     };
     record();
     // One CSV row for the step just taken (`last`: the rollout's end).
+    const std::string quoted_label = CsvQuoted(source.label);
     auto record_frame = [&](bool last) {
       if (args.frames_csv.empty()) return;
       const ReprojectionError& error = rollout.last_error();
@@ -471,12 +473,13 @@ int RunTrackedGenerations(const GenerateArgs& args) {
       const bool named =
           error.worst_keypoint >= 0 &&
           error.worst_keypoint < static_cast<int>(keypoint_names.size());
-      frames_csv +=
-          std::to_string(stream_index) + "," + CsvQuoted(source.label) +
-          numbers + (named ? keypoint_names[error.worst_keypoint] : "") + "," +
-          (last ? StreamedRolloutEnd(rollout, env_options.max_episode_steps())
-                : "") +
-          "\n";
+      frames_csv += std::to_string(stream_index) + "," + quoted_label +
+                    numbers +
+                    (named ? keypoint_names[error.worst_keypoint] : "") + "," +
+                    (last ? RolloutEndName(StreamedRolloutEnd(
+                                rollout, env_options.max_episode_steps()))
+                          : "") +
+                    "\n";
     };
     const auto started = std::chrono::steady_clock::now();
     while (rollout.Step(policy)) {

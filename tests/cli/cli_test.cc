@@ -155,7 +155,7 @@ TEST(Cli, GenerateDrivesATrackerAlongTheStream) {
     for (const auto& [stream, row] : last_row_by_stream) {
       const std::string end = row.substr(row.rfind(',') + 1);
       EXPECT_TRUE(end == "time_limit" || end == "early_exit" ||
-                  end == "stream_end" || end == "diverged")
+                  end == "clip_end" || end == "diverged")
           << row;
     }
   }
