@@ -52,9 +52,13 @@ RewardTerms ComputeReward(const ReprojectionError& pose_error,
     terms.object =
         std::exp(-weights.object_alpha_per_px * object_error->weighted_sum_px);
   }
+  // Like the pose term, a frame without reference keypoints costs nothing.
+  if (weights.worst_weight > 0.0)
+    terms.worst = std::exp(-weights.worst_alpha_per_px * pose_error.max_px);
   terms.total = weights.pose_weight * terms.pose +
                 weights.energy_weight * terms.energy +
-                weights.object_weight * terms.object;
+                weights.object_weight * terms.object +
+                weights.worst_weight * terms.worst;
   return terms;
 }
 

@@ -61,6 +61,12 @@ struct RewardWeights {
   double energy_weight = 1e-4;        // w_e, per watt of |qdot . tau|
   double object_weight = 0.0;         // weight of the object 2D term
   double object_alpha_per_px = 0.02;  // alpha of the object term (1/px)
+  // The worst keypoint's own term. The early exit (and so Succ) is decided by
+  // the worst keypoint, but the tracking term sees it only as one of 17 in a
+  // sum, so a foot drifting while the body tracks costs little until the
+  // episode ends (docs/generation.md 4b, "A term for the worst keypoint").
+  double worst_weight = 0.0;          // w_w (0: no such term)
+  double worst_alpha_per_px = 0.02;   // alpha_w, on the worst keypoint (1/px)
 
   // Every setting (common/settings.h); a training config's `env.reward`.
   template <typename Self, typename Visitor>
@@ -76,6 +82,11 @@ struct RewardWeights {
       "weight of the object's 2D term (0: no object)");
     v("object_alpha_per_px", self.object_alpha_per_px, Range::Above(0),
       "alpha (1/px) of the object term");
+    v("worst_weight", self.worst_weight, Range::AtLeast(0),
+      "w_w, weight of exp(-alpha_w * the worst keypoint's error), the "
+      "keypoint the early exit compares (0: no such term)");
+    v("worst_alpha_per_px", self.worst_alpha_per_px, Range::Above(0),
+      "alpha_w (1/px) on the worst keypoint's error");
   }
   void Validate() const;  // throws ConfigError
 };
@@ -86,11 +97,13 @@ struct RewardTerms {
   double pose = 0.0;
   double energy = 0.0;  // -sum_j |qdot_j tau_j| (W), <= 0
   double object = 0.0;  // exp(-alpha_o * object error), 0 if untracked
-  double total = 0.0;   // w_p pose + w_e energy + w_o object
+  double worst = 0.0;   // exp(-alpha_w * max_j |P(x_j) - x^_j|); 0 if w_w = 0
+  double total = 0.0;   // w_p pose + w_e energy + w_o object + w_w worst
 };
 
-// r = w_p exp(-alpha sum_j c_j |P(x_j) - x^_j|) + w_e r_e (+ w_o r_o), with
-// r_e = -sum_j |qdot_j tau_j|. `object_error` may be null (no object).
+// r = w_p exp(-alpha sum_j c_j |P(x_j) - x^_j|) + w_e r_e (+ w_o r_o)
+// (+ w_w exp(-alpha_w max_j |P(x_j) - x^_j|)), with r_e = -sum_j |qdot_j
+// tau_j|. `object_error` may be null (no object).
 RewardTerms ComputeReward(const ReprojectionError& pose_error,
                           double abs_power_w,
                           const ReprojectionError* object_error,

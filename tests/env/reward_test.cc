@@ -75,6 +75,38 @@ TEST(Reward, ObjectTermOnlyWhenTheObjectIsSeen) {
   EXPECT_NEAR(terms.total, 1.0 + 0.5 * terms.object, 1e-12);
 }
 
+TEST(Reward, WorstKeypointTermFollowsTheKeypointTheEarlyExitCompares) {
+  RewardWeights weights;
+  ReprojectionError error;
+  error.num_present = 17;
+  error.weighted_sum_px = 17 * 10.0 + 40.0;  // one ankle 50 px off, 16 at 10
+  error.max_px = 50.0;
+  // Off by default: the reward is the pose term's alone.
+  RewardTerms terms = ComputeReward(error, 0.0, nullptr, weights);
+  EXPECT_DOUBLE_EQ(terms.worst, 0.0);
+  EXPECT_DOUBLE_EQ(terms.total, terms.pose);
+
+  weights.worst_weight = 0.5;
+  weights.worst_alpha_per_px = 0.02;
+  terms = ComputeReward(error, 0.0, nullptr, weights);
+  EXPECT_NEAR(terms.worst, std::exp(-1.0), 1e-12);
+  EXPECT_NEAR(terms.total, terms.pose + 0.5 * std::exp(-1.0), 1e-12);
+  // The drifting keypoint costs more under the term than in the sum alone:
+  // 10 px more on it lowers the worst term by a factor exp(-0.2).
+  ReprojectionError worse = error;
+  worse.weighted_sum_px += 10.0;
+  worse.max_px += 10.0;
+  const RewardTerms worse_terms = ComputeReward(worse, 0.0, nullptr, weights);
+  EXPECT_NEAR(worse_terms.worst / terms.worst, std::exp(-0.2), 1e-12);
+  EXPECT_NEAR(worse_terms.pose / terms.pose,
+              std::exp(-10.0 * weights.pose_alpha_per_px), 1e-12);
+  // A perfect match earns both weights.
+  EXPECT_DOUBLE_EQ(
+      ComputeReward(ReprojectionError(), 0.0, nullptr, weights).total, 1.5);
+  weights.worst_alpha_per_px = 0.0;
+  EXPECT_THROW(weights.Validate(), ConfigError);
+}
+
 TEST(Reward, EarlyExitThreshold) {
   ReprojectionError error;
   error.max_px = 99.0;
