@@ -55,10 +55,9 @@ RewardTerms ComputeReward(const ReprojectionError& pose_error,
   // Like the pose term, a frame without reference keypoints costs nothing.
   if (weights.worst_weight > 0.0)
     terms.worst = std::exp(-weights.worst_alpha_per_px * pose_error.max_px);
-  terms.total = weights.pose_weight * terms.pose +
-                weights.energy_weight * terms.energy +
-                weights.object_weight * terms.object +
-                weights.worst_weight * terms.worst;
+  terms.total =
+      weights.pose_weight * terms.pose + weights.energy_weight * terms.energy +
+      weights.object_weight * terms.object + weights.worst_weight * terms.worst;
   return terms;
 }
 

@@ -65,8 +65,8 @@ struct RewardWeights {
   // the worst keypoint, but the tracking term sees it only as one of 17 in a
   // sum, so a foot drifting while the body tracks costs little until the
   // episode ends (docs/generation.md 4b, "A term for the worst keypoint").
-  double worst_weight = 0.0;          // w_w (0: no such term)
-  double worst_alpha_per_px = 0.02;   // alpha_w, on the worst keypoint (1/px)
+  double worst_weight = 0.0;         // w_w (0: no such term)
+  double worst_alpha_per_px = 0.02;  // alpha_w, on the worst keypoint (1/px)
 
   // Every setting (common/settings.h); a training config's `env.reward`.
   template <typename Self, typename Visitor>
