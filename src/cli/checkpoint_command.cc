@@ -1,9 +1,11 @@
-// cli: `mimic2d checkpoint info|slim` — what a training checkpoint holds,
-// and the same checkpoint without its ASI state buffers, small enough to
-// commit as a policy or carry through git.
+// cli: `mimic2d checkpoint info|slim|average` — what a training checkpoint
+// holds, the same checkpoint without its ASI state buffers (small enough to
+// commit as a policy or carry through git), and the mean of a line's
+// checkpoints.
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/commands.h"
 #include "rl/checkpoint.h"
@@ -24,6 +26,24 @@ int RunSlim(const SlimArgs& args) {
       "%lld samples kept, ASI state buffers left out)\n",
       args.output.c_str(), summary.bytes_after / 1e6,
       summary.bytes_before / 1e6, static_cast<long long>(summary.samples));
+  return 0;
+}
+
+struct AverageArgs {
+  std::vector<std::string> inputs;
+  std::string output;
+};
+
+int RunAverage(const AverageArgs& args) {
+  const AveragedCheckpointSummary summary =
+      AverageCheckpoints(args.inputs, args.output);
+  std::printf(
+      "wrote %s: the mean of %d checkpoints' networks and normalizers "
+      "(%lld to %lld samples); optimizer, counters and config of the last, "
+      "no ASI state buffers\n",
+      args.output.c_str(), summary.num_averaged,
+      static_cast<long long>(summary.first_samples),
+      static_cast<long long>(summary.last_samples));
   return 0;
 }
 
@@ -97,7 +117,7 @@ void AddCheckpointCommand(CLI::App& app, CommandRun* run) {
   CLI::App* checkpoint = app.add_subcommand(
       "checkpoint",
       "Inspect or convert training checkpoints (info: what one holds; slim: "
-      "without ASI buffers)");
+      "without ASI buffers; average: the mean of a line's checkpoints)");
   checkpoint->require_subcommand(1);
   auto info_args = std::make_shared<InfoArgs>();
   CLI::App* info = checkpoint->add_subcommand(
@@ -123,6 +143,25 @@ void AddCheckpointCommand(CLI::App& app, CommandRun* run) {
       ->check(WritableFile())
       ->required();
   slim->callback([run, args] { *run = [args] { return RunSlim(*args); }; });
+  auto average_args = std::make_shared<AverageArgs>();
+  CLI::App* average = checkpoint->add_subcommand(
+      "average",
+      "Write the element-wise mean of checkpoints of one line (same networks "
+      "and layout): networks and observation normalizers averaged; "
+      "optimizer, counters and config of the last; no ASI buffers");
+  average
+      ->add_option("checkpoints", average_args->inputs,
+                   "Two or more train checkpoints (.pt) of one line, oldest "
+                   "first")
+      ->required()
+      ->expected(2, -1)
+      ->check(CLI::ExistingFile);
+  average->add_option("-o,--output", average_args->output, "Where to write it")
+      ->check(WritableFile())
+      ->required();
+  average->callback([run, average_args] {
+    *run = [average_args] { return RunAverage(*average_args); };
+  });
 }
 
 }  // namespace m2d::cli

@@ -441,6 +441,50 @@ SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
   return summary;
 }
 
+AveragedCheckpointSummary AverageCheckpoints(
+    const std::vector<std::string>& inputs, const std::string& out) {
+  if (inputs.size() < 2) {
+    throw ConfigError("checkpoint average: needs 2 or more checkpoints, got " +
+                      std::to_string(inputs.size()));
+  }
+  // Build the networks the last checkpoint's config describes; every input
+  // loads into a copy of them (LoadCheckpoint names a file whose networks
+  // or layout differ) and is summed into the running total.
+  const std::string& last = inputs.back();
+  const TrainConfig config = ReadCheckpointConfig(last);
+  int action_size = 0;
+  const ObservationLayout layout = ReadCheckpointLayout(last, &action_size);
+  ActorCritic mean_model(layout, config.model, action_size);
+  torch::optim::Adam optimizer(
+      mean_model->parameters(),
+      torch::optim::AdamOptions(config.ppo.learning_rate));
+  const CheckpointCounters counters = LoadCheckpoint(
+      last, mean_model, &optimizer, /*initial_states=*/nullptr, SimState());
+  AveragedCheckpointSummary summary;
+  summary.num_averaged = static_cast<int>(inputs.size());
+  summary.last_samples = counters.samples;
+  torch::NoGradGuard no_grad;
+  for (size_t i = 0; i + 1 < inputs.size(); ++i) {
+    ActorCritic model(layout, config.model, action_size);
+    const CheckpointCounters input_counters =
+        LoadCheckpoint(inputs[i], model, /*optimizer=*/nullptr,
+                       /*initial_states=*/nullptr, SimState());
+    if (i == 0) summary.first_samples = input_counters.samples;
+    // Parameters, then buffers (the normalizers' mean, variance and count),
+    // matched by name.
+    for (auto& named : model->named_parameters())
+      mean_model->named_parameters()[named.key()].add_(named.value());
+    for (auto& named : model->named_buffers())
+      mean_model->named_buffers()[named.key()].add_(named.value());
+  }
+  const double scale = 1.0 / static_cast<double>(inputs.size());
+  for (auto& tensor : mean_model->parameters()) tensor.mul_(scale);
+  for (auto& tensor : mean_model->buffers()) tensor.mul_(scale);
+  SaveCheckpoint(out, config, mean_model, optimizer, counters,
+                 /*initial_states=*/nullptr, SimState());
+  return summary;
+}
+
 CheckpointInfo ReadCheckpointInfo(const std::string& path) {
   // One read of the file (a checkpoint with buffers is tens of MB).
   CheckpointInfo info;

@@ -6,6 +6,7 @@
 #include <torch/torch.h>
 
 #include <string>
+#include <vector>
 
 #include "env/reference.h"
 #include "rl/networks.h"
@@ -69,6 +70,24 @@ struct SlimCheckpointSummary {
 // not a mimic2d checkpoint.
 SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
                                           const std::string& out);
+
+// What AverageCheckpoints made.
+struct AveragedCheckpointSummary {
+  int num_averaged = 0;
+  int64_t first_samples = 0;  // the inputs' counters, first and last
+  int64_t last_samples = 0;
+};
+
+// Writes to `out` (atomically) the element-wise mean of the networks and
+// observation normalizers of `inputs`, checkpoints of one line (the same
+// config's networks and layout): a policy averaged over the line's recent
+// checkpoints, whose figures swing from one checkpoint to the next
+// (docs/training.md, "Averaging a line's checkpoints"). The optimizer,
+// counters and config are the last input's; no ASI buffers are kept (as
+// `slim`). InputError naming the file when an input is not a checkpoint or
+// its networks differ from the first's; ConfigError for fewer than 2 inputs.
+AveragedCheckpointSummary AverageCheckpoints(
+    const std::vector<std::string>& inputs, const std::string& out);
 
 // What a checkpoint holds, read without building its task or networks
 // (`mimic2d checkpoint info`).

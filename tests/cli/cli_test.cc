@@ -784,11 +784,20 @@ TEST(Cli, BadInputIsAClearErrorNotACrash) {
   ExpectInputError("clip info " + dir + "/absent.json", dir + "/absent.json",
                    "cannot open");
 
-  // A file that is not a training checkpoint, to both checkpoint commands.
+  // A file that is not a training checkpoint, to every checkpoint command.
   ExpectInputError("checkpoint info " + malformed, malformed,
                    "not a mimic2d checkpoint");
   ExpectInputError("checkpoint slim " + malformed + " -o " + dir + "/out.pt",
                    malformed, "not a mimic2d checkpoint");
+  ExpectInputError("checkpoint average " + malformed + " " + malformed +
+                       " -o " + dir + "/out.pt",
+                   malformed, "not a mimic2d checkpoint");
+  // One checkpoint is nothing to average: a usage error.
+  const CommandResult one_input =
+      RunMimic2d("checkpoint average " + malformed + " -o " + dir + "/out.pt");
+  EXPECT_NE(one_input.exit_code, 0);
+  EXPECT_NE(one_input.output.find("checkpoints"), std::string::npos)
+      << one_input.output;
   EXPECT_FALSE(std::ifstream(dir + "/out.pt").good());
   EXPECT_FALSE(
       std::ifstream(dir + "/out.json").good());  // nothing half-written

@@ -538,5 +538,91 @@ TEST(Checkpoint, ASlimCheckpointKeepsAllButTheStateBuffersAndInfoSaysSo) {
   fs::remove_all(dir);
 }
 
+// `checkpoint average`: the networks and normalizers are the element-wise
+// mean; the optimizer and counters the last input's; another line's
+// networks are refused, naming the file.
+TEST(Checkpoint, AveragingCheckpointsOfALineTakesTheMeanOfTheirNetworks) {
+  const std::string dir = testing::TempDir("checkpoint_average");
+  TrainConfig config;
+  config.data.bundles = {"walk.json"};
+  config.model = SmallModel();
+  std::vector<std::string> paths;
+  std::vector<TrainedModel> saved;
+  for (int i = 0; i < 3; ++i) {
+    saved.push_back(MakeTrainedModel(SmallLayout(), kActions, 10 + i));
+    CheckpointCounters counters;
+    counters.iteration = 10 * (i + 1);
+    counters.samples = 1000 * (i + 1);
+    paths.push_back(dir + "/ckpt_" + std::to_string(i) + ".pt");
+    SaveCheckpoint(paths.back(), config, saved.back().model,
+                   *saved.back().optimizer, counters, nullptr, SimState());
+  }
+  const std::string out = dir + "/mean.pt";
+  const AveragedCheckpointSummary summary = AverageCheckpoints(paths, out);
+  EXPECT_EQ(summary.num_averaged, 3);
+  EXPECT_EQ(summary.first_samples, 1000);
+  EXPECT_EQ(summary.last_samples, 3000);
+
+  TrainedModel loaded = MakeFreshModel(SmallLayout(), kActions, 99);
+  const CheckpointCounters read = LoadCheckpoint(
+      out, loaded.model, loaded.optimizer.get(), nullptr, SimState());
+  EXPECT_EQ(read.samples, 3000);
+  EXPECT_EQ(read.iteration, 30);
+  auto expect_mean = [&](auto named_of) {
+    for (const auto& named : named_of(*loaded.model)) {
+      torch::Tensor sum = torch::zeros_like(named.value());
+      for (TrainedModel& model : saved)
+        sum += named_of(*model.model)[named.key()];
+      EXPECT_TRUE(torch::allclose(named.value(), sum / 3.0, 1e-5, 1e-6))
+          << named.key();
+    }
+  };
+  expect_mean([](ActorCriticImpl& m) { return m.named_parameters(); });
+  expect_mean([](ActorCriticImpl& m) { return m.named_buffers(); });
+  // The weights moved: the mean is none of the inputs.
+  EXPECT_FALSE(SameTensors(loaded.model->named_parameters(),
+                           saved[0].model->named_parameters()));
+  // Adam's moments are the last input's: a resumed run updates as it would.
+  // (The fixed log_std takes no gradient and has none.)
+  const std::vector<torch::Tensor> last_parameters =
+      saved[2].model->parameters();
+  const std::vector<torch::Tensor> mean_parameters = loaded.model->parameters();
+  int with_state = 0;
+  for (size_t i = 0; i < last_parameters.size(); ++i) {
+    const auto* last = AdamState(*saved[2].optimizer, last_parameters[i]);
+    const auto* mean = AdamState(*loaded.optimizer, mean_parameters[i]);
+    ASSERT_EQ(last == nullptr, mean == nullptr) << i;
+    if (last == nullptr) continue;
+    ++with_state;
+    EXPECT_TRUE(torch::equal(last->exp_avg(), mean->exp_avg())) << i;
+    EXPECT_TRUE(torch::equal(last->exp_avg_sq(), mean->exp_avg_sq())) << i;
+  }
+  EXPECT_EQ(with_state, static_cast<int>(last_parameters.size()) - 1);
+
+  // Another line's networks (a wider policy), a file that is no checkpoint,
+  // and a single input are refused; nothing is written.
+  TrainConfig wider = config;
+  wider.model.policy_hidden = {48};
+  torch::manual_seed(5);
+  ActorCritic other(SmallLayout(), wider.model, kActions);
+  torch::optim::Adam other_optimizer(other->parameters(),
+                                     torch::optim::AdamOptions(1e-3));
+  const std::string other_path = dir + "/other.pt";
+  SaveCheckpoint(other_path, wider, other, other_optimizer,
+                 CheckpointCounters(), nullptr, SimState());
+  const std::string refused = dir + "/refused.pt";
+  ExpectInputErrorNaming(other_path, [&] {
+    AverageCheckpoints({other_path, paths[2]}, refused);
+  });
+  const std::string text_path = dir + "/notes.txt";
+  std::ofstream(text_path) << "not a checkpoint\n";
+  ExpectInputErrorNaming(text_path, [&] {
+    AverageCheckpoints({paths[0], text_path}, refused);
+  });
+  EXPECT_THROW(AverageCheckpoints({paths[0]}, refused), ConfigError);
+  EXPECT_FALSE(fs::exists(refused));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace m2d
