@@ -15,6 +15,8 @@
 # figure before 2026-12-06's sixth session; draw d uses seeds 9d+1...9d+9,
 # logged as OUT_PREFIX_generated[_d].log, every rollout's per-frame errors in
 # OUT_PREFIX_frames[_d].csv). One draw moves the count by 2-3.
+# FIRST_DRAW: the first draw d (default 0); FIRST_DRAW=4 DRAWS=4 measures
+# seeds 37-72, streams no figure before 2026-12-07's seventh session saw.
 # START_FIT_S, START_AT_S: generate's --start-fit-s (the stream's first
 # seconds fitted, default 2) and --start-at-s (where the rollout starts,
 # default the middle of the fitted seconds); figures before 2026-12-07 are
@@ -30,7 +32,8 @@ start_options=()
 [ -n "${START_FIT_S:-}" ] && start_options+=(--start-fit-s "$START_FIT_S")
 [ -n "${START_AT_S:-}" ] && start_options+=(--start-at-s "$START_AT_S")
 [ -n "${START_TILT:-}" ] && start_options+=(--start-tilt "$START_TILT")
-for ((draw = 0; draw < ${DRAWS:-1}; ++draw)); do
+first_draw=${FIRST_DRAW:-0}
+for ((draw = first_draw; draw < first_draw + ${DRAWS:-1}; ++draw)); do
   suffix=""
   [ "$draw" -gt 0 ] && suffix="_$draw"
   build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
