@@ -464,6 +464,8 @@ AveragedCheckpointSummary AverageCheckpoints(
   summary.num_averaged = static_cast<int>(inputs.size());
   summary.last_samples = counters.samples;
   torch::NoGradGuard no_grad;
+  auto mean_parameters = mean_model->named_parameters();
+  auto mean_buffers = mean_model->named_buffers();
   for (size_t i = 0; i + 1 < inputs.size(); ++i) {
     ActorCritic model(layout, config.model, action_size);
     const CheckpointCounters input_counters =
@@ -473,13 +475,13 @@ AveragedCheckpointSummary AverageCheckpoints(
     // Parameters, then buffers (the normalizers' mean, variance and count),
     // matched by name.
     for (auto& named : model->named_parameters())
-      mean_model->named_parameters()[named.key()].add_(named.value());
+      mean_parameters[named.key()].add_(named.value());
     for (auto& named : model->named_buffers())
-      mean_model->named_buffers()[named.key()].add_(named.value());
+      mean_buffers[named.key()].add_(named.value());
   }
   const double scale = 1.0 / static_cast<double>(inputs.size());
-  for (auto& tensor : mean_model->parameters()) tensor.mul_(scale);
-  for (auto& tensor : mean_model->buffers()) tensor.mul_(scale);
+  for (auto& named : mean_parameters) named.value().mul_(scale);
+  for (auto& named : mean_buffers) named.value().mul_(scale);
   SaveCheckpoint(out, config, mean_model, optimizer, counters,
                  /*initial_states=*/nullptr, SimState());
   return summary;

@@ -85,7 +85,8 @@ struct AveragedCheckpointSummary {
 // (docs/training.md, "Averaging a line's checkpoints"). The optimizer,
 // counters and config are the last input's; no ASI buffers are kept (as
 // `slim`). InputError naming the file when an input is not a checkpoint or
-// its networks differ from the first's; ConfigError for fewer than 2 inputs.
+// its networks or layout differ from the last's; ConfigError for fewer than 2
+// inputs.
 AveragedCheckpointSummary AverageCheckpoints(
     const std::vector<std::string>& inputs, const std::string& out);
 

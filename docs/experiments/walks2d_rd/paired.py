@@ -4,7 +4,7 @@ the same streams: held per tracker, per group, held by one alone, and the
 two-sided sign test on the discordant streams.
   docs/experiments/walks2d_rd/paired.py PREFIX_A PREFIX_B DRAWS [FIRST_DRAW]
 (FIRST_DRAW as measure.sh's: 4 compares draws 4..4+DRAWS-1, seeds 37-.)
-e.g. paired.py docs/experiments/walks2d_rd/push_46.1 docs/experiments/walks2d_rd/worst_60 4
+e.g. paired.py docs/experiments/walks2d_rd/push_46.1 docs/experiments/walks2d_rd/worst_avg47-61 4 4
 """
 import math
 import re
