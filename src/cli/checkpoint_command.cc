@@ -39,7 +39,7 @@ int RunAverage(const AverageArgs& args) {
       AverageCheckpoints(args.inputs, args.output);
   std::printf(
       "wrote %s: the mean of %d checkpoints' networks and normalizers "
-      "(%lld to %lld samples); optimizer, counters and config of the last, "
+      "(%lld to %lld samples); optimizer, counters and config of the newest, "
       "no ASI state buffers\n",
       args.output.c_str(), summary.num_averaged,
       static_cast<long long>(summary.first_samples),
@@ -148,11 +148,12 @@ void AddCheckpointCommand(CLI::App& app, CommandRun* run) {
       "average",
       "Write the element-wise mean of checkpoints of one line (same networks "
       "and layout): networks and observation normalizers averaged; "
-      "optimizer, counters and config of the last; no ASI buffers");
+      "optimizer, counters and config of the newest (most samples); no ASI "
+      "buffers");
   average
       ->add_option("checkpoints", average_args->inputs,
-                   "Two or more train checkpoints (.pt) of one line, oldest "
-                   "first")
+                   "Two or more train checkpoints (.pt) of one line, in any "
+                   "order")
       ->required()
       ->expected(2, -1)
       ->check(CLI::ExistingFile);

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -447,31 +448,40 @@ AveragedCheckpointSummary AverageCheckpoints(
     throw ConfigError("checkpoint average: needs 2 or more checkpoints, got " +
                       std::to_string(inputs.size()));
   }
-  // Build the networks the last checkpoint's config describes; every input
-  // loads into a copy of them (LoadCheckpoint names a file whose networks
-  // or layout differ) and is summed into the running total.
-  const std::string& last = inputs.back();
-  const TrainConfig config = ReadCheckpointConfig(last);
+  // The newest input (most samples) gives the networks' shape, optimizer,
+  // counters and config: a shell glob lists ckpt_<samples>.pt by text, so
+  // 9.9M comes after 10.1M. Every other input loads into a copy of its
+  // networks (LoadCheckpoint names a file whose networks or layout differ)
+  // and is summed into the running total.
+  std::vector<int64_t> input_samples;
+  for (const std::string& input : inputs)
+    input_samples.push_back(ReadCheckpointInfo(input).counters.samples);
+  const size_t newest = static_cast<size_t>(
+      std::max_element(input_samples.begin(), input_samples.end()) -
+      input_samples.begin());
+  const std::string& base = inputs[newest];
+  const TrainConfig config = ReadCheckpointConfig(base);
   int action_size = 0;
-  const ObservationLayout layout = ReadCheckpointLayout(last, &action_size);
+  const ObservationLayout layout = ReadCheckpointLayout(base, &action_size);
   ActorCritic mean_model(layout, config.model, action_size);
   torch::optim::Adam optimizer(
       mean_model->parameters(),
       torch::optim::AdamOptions(config.ppo.learning_rate));
   const CheckpointCounters counters = LoadCheckpoint(
-      last, mean_model, &optimizer, /*initial_states=*/nullptr, SimState());
+      base, mean_model, &optimizer, /*initial_states=*/nullptr, SimState());
   AveragedCheckpointSummary summary;
   summary.num_averaged = static_cast<int>(inputs.size());
+  summary.first_samples =
+      *std::min_element(input_samples.begin(), input_samples.end());
   summary.last_samples = counters.samples;
   torch::NoGradGuard no_grad;
   auto mean_parameters = mean_model->named_parameters();
   auto mean_buffers = mean_model->named_buffers();
-  for (size_t i = 0; i + 1 < inputs.size(); ++i) {
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    if (i == newest) continue;
     ActorCritic model(layout, config.model, action_size);
-    const CheckpointCounters input_counters =
-        LoadCheckpoint(inputs[i], model, /*optimizer=*/nullptr,
-                       /*initial_states=*/nullptr, SimState());
-    if (i == 0) summary.first_samples = input_counters.samples;
+    LoadCheckpoint(inputs[i], model, /*optimizer=*/nullptr,
+                   /*initial_states=*/nullptr, SimState());
     // Parameters, then buffers (the normalizers' mean, variance and count),
     // matched by name.
     for (auto& named : model->named_parameters())

@@ -74,7 +74,7 @@ SlimCheckpointSummary WriteSlimCheckpoint(const std::string& in,
 // What AverageCheckpoints made.
 struct AveragedCheckpointSummary {
   int num_averaged = 0;
-  int64_t first_samples = 0;  // the inputs' counters, first and last
+  int64_t first_samples = 0;  // the inputs' fewest and most samples
   int64_t last_samples = 0;
 };
 
@@ -83,10 +83,10 @@ struct AveragedCheckpointSummary {
 // config's networks and layout): a policy averaged over the line's recent
 // checkpoints, whose figures swing from one checkpoint to the next
 // (docs/training.md, "Averaging a line's checkpoints"). The optimizer,
-// counters and config are the last input's; no ASI buffers are kept (as
-// `slim`). InputError naming the file when an input is not a checkpoint or
-// its networks or layout differ from the last's; ConfigError for fewer than 2
-// inputs.
+// counters and config are the newest input's (most samples); no ASI buffers are
+// kept (as `slim`). The inputs may come in any order. InputError naming the
+// file when an input is not a checkpoint or its networks or layout differ from
+// the newest's; ConfigError for fewer than 2 inputs.
 AveragedCheckpointSummary AverageCheckpoints(
     const std::vector<std::string>& inputs, const std::string& out);
 

@@ -558,7 +558,10 @@ TEST(Checkpoint, AveragingCheckpointsOfALineTakesTheMeanOfTheirNetworks) {
                    *saved.back().optimizer, counters, nullptr, SimState());
   }
   const std::string out = dir + "/mean.pt";
-  const AveragedCheckpointSummary summary = AverageCheckpoints(paths, out);
+  // Out of order, as a shell glob lists ckpt_<samples>.pt by text: the
+  // newest (most samples) still gives the counters and optimizer.
+  const AveragedCheckpointSummary summary =
+      AverageCheckpoints({paths[2], paths[0], paths[1]}, out);
   EXPECT_EQ(summary.num_averaged, 3);
   EXPECT_EQ(summary.first_samples, 1000);
   EXPECT_EQ(summary.last_samples, 3000);
@@ -582,7 +585,7 @@ TEST(Checkpoint, AveragingCheckpointsOfALineTakesTheMeanOfTheirNetworks) {
   // The weights moved: the mean is none of the inputs.
   EXPECT_FALSE(SameTensors(loaded.model->named_parameters(),
                            saved[0].model->named_parameters()));
-  // Adam's moments are the last input's: a resumed run updates as it would.
+  // Adam's moments are the newest input's: a resumed run updates as it would.
   // (The fixed log_std takes no gradient and has none.)
   const std::vector<torch::Tensor> last_parameters =
       saved[2].model->parameters();
