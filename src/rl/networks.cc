@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
+
+#include "common/error.h"
 
 namespace m2d {
 
@@ -135,6 +138,83 @@ torch::Tensor ActorCriticImpl::LogProb(const torch::Tensor& mean,
 
 torch::Tensor ActorCriticImpl::Entropy() const {
   return (log_std + 0.5 * std::log(2.0 * M_PI * M_E)).sum();
+}
+
+void WidenFutureFrames(ActorCriticImpl& source, ActorCriticImpl& target) {
+  const ObservationLayout& from = source.layout();
+  const ObservationLayout& to = target.layout();
+  if (from.num_bodies != to.num_bodies || from.num_objects != to.num_objects ||
+      from.num_points != to.num_points ||
+      from.critic_only_size != to.critic_only_size ||
+      source.action_size() != target.action_size() ||
+      from.num_future_frames >= to.num_future_frames) {
+    throw ConfigError(
+        "widening the future frames: the source's observation differs in "
+        "more than a shorter horizon (" +
+        std::to_string(from.num_future_frames) + " future frames against " +
+        std::to_string(to.num_future_frames) + ")");
+  }
+  // Outline: the view block is frame-major (the current projection, then
+  // future frames 1..L, each num_points x kPointFeatures wide), so the
+  // source's columns are the first ones of the target's.
+  const int64_t frame_width =
+      from.num_points * ObservationLayout::kPointFeatures;
+  const int64_t kept = from.view_size();
+  torch::NoGradGuard no_grad;
+  const auto source_tensor =
+      [](const torch::OrderedDict<std::string, torch::Tensor>& tensors,
+         const std::string& key) -> const torch::Tensor& {
+    const torch::Tensor* found = tensors.find(key);
+    if (found == nullptr) {
+      throw ConfigError("widening the future frames: the source has no " + key);
+    }
+    return *found;
+  };
+  const auto source_parameters = source.named_parameters();
+  for (auto& named : target.named_parameters()) {
+    const torch::Tensor& from_tensor =
+        source_tensor(source_parameters, named.key());
+    torch::Tensor& to_tensor = named.value();
+    if (from_tensor.sizes() == to_tensor.sizes()) {
+      to_tensor.copy_(from_tensor);
+    } else if ((named.key() == "actor_encoder.0.weight" ||
+                named.key() == "critic_encoder.0.weight") &&
+               from_tensor.size(0) == to_tensor.size(0) &&
+               from_tensor.size(1) == kept) {
+      // The encoders' first layers: the new frames' columns start at zero.
+      to_tensor.zero_();
+      to_tensor.narrow(1, 0, kept).copy_(from_tensor);
+    } else {
+      throw ConfigError("widening the future frames: " + named.key() +
+                        " differs in shape (model.*_hidden or "
+                        "encoder_features changed)");
+    }
+  }
+  const auto source_buffers = source.named_buffers();
+  for (auto& named : target.named_buffers()) {
+    const torch::Tensor& from_tensor =
+        source_tensor(source_buffers, named.key());
+    torch::Tensor& to_tensor = named.value();
+    if (from_tensor.sizes() == to_tensor.sizes()) {
+      to_tensor.copy_(from_tensor);
+      continue;
+    }
+    // The view normalizer's mean and variance: the source's, then its last
+    // future frame's repeated over the new frames.
+    if ((named.key() != "view_normalizer.mean" &&
+         named.key() != "view_normalizer.variance") ||
+        from_tensor.size(0) != kept) {
+      throw ConfigError("widening the future frames: " + named.key() +
+                        " differs in shape");
+    }
+    to_tensor.narrow(0, 0, kept).copy_(from_tensor);
+    const torch::Tensor last_frame =
+        from_tensor.narrow(0, kept - frame_width, frame_width);
+    for (int64_t column = kept; column < to_tensor.size(0);
+         column += frame_width) {
+      to_tensor.narrow(0, column, frame_width).copy_(last_frame);
+    }
+  }
 }
 
 namespace {

@@ -73,6 +73,16 @@ class ActorCriticImpl : public torch::nn::Module {
 };
 TORCH_MODULE(ActorCritic);
 
+// Copies `source`'s weights and observation statistics into `target`, whose
+// layout differs from the source's only by more future reference frames
+// (`run.init_from` a checkpoint trained with a shorter horizon). The
+// encoders' first layers keep the source's weights for the frames it read
+// and start at zero for the new ones, so `target` acts and values exactly as
+// `source` until training moves those weights; the new frames' normalizer
+// statistics start as the source's last future frame's. ConfigError naming
+// what differs when the layouts or networks differ otherwise.
+void WidenFutureFrames(ActorCriticImpl& source, ActorCriticImpl& target);
+
 // Within its scope (on this thread: autocast state is thread-local), matrix
 // products run in bfloat16 when the precision says so (LibTorch's CPU
 // autocast; oneDNN uses AMX or AVX512-BF16 where the CPU has them); weights

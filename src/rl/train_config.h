@@ -382,9 +382,10 @@ struct RunOptions {
       "process may use)");
     v("init_from", self.init_from, Range::Any(),
       "a fresh run starts from this checkpoint's networks and observation "
-      "normalizer (same character, observation and network sizes); the "
-      "optimizer, initial-state buffers and counters start fresh, an "
-      "adaptive rate at the source's; empty: random weights");
+      "normalizer (same character, observation and network sizes; a "
+      "source with fewer future frames is widened, the new frames' weights "
+      "at zero); the optimizer, initial-state buffers and counters start "
+      "fresh, an adaptive rate at the source's; empty: random weights");
   }
   void Validate() const;
 };

@@ -136,10 +136,34 @@ struct Trainer::State {
   // Fine-tuning: the networks and normalizer of `path` (InputError naming it
   // when its networks do not fit this config); the fixed sigma stays the
   // config's. Optimizer, buffers and counters stay fresh.
+  // A source trained with fewer future frames (env.num_future_frames) is
+  // widened to this config's (WidenFutureFrames: the new frames' weights
+  // start at zero, so the policy starts as the source's).
   CheckpointCounters InitializeNetworksFrom(const std::string& path) {
-    const CheckpointCounters from =
-        LoadCheckpoint(path, model, /*optimizer=*/nullptr,
-                       /*initial_states=*/nullptr, state_template);
+    int source_actions = 0;
+    const ObservationLayout source_layout =
+        ReadCheckpointLayout(path, &source_actions);
+    const int horizon = model->layout().num_future_frames;
+    CheckpointCounters from;
+    if (source_layout.num_future_frames < horizon) {
+      ActorCritic source(source_layout, ReadCheckpointConfig(path).model,
+                         source_actions);
+      from = LoadCheckpoint(path, source, /*optimizer=*/nullptr,
+                            /*initial_states=*/nullptr, state_template);
+      try {
+        WidenFutureFrames(*source, *model);
+      } catch (const ConfigError& error) {
+        throw InputError(path, error.what());
+      }
+      spdlog::info(
+          "future frames widened from {} to {}: the new frames' encoder "
+          "weights start at zero, their normalizer statistics at the "
+          "source's last future frame's",
+          source_layout.num_future_frames, horizon);
+    } else {
+      from = LoadCheckpoint(path, model, /*optimizer=*/nullptr,
+                            /*initial_states=*/nullptr, state_template);
+    }
     ApplyConfiguredActionStd();
     spdlog::info("networks initialized from {} ({} samples of training there)",
                  path, from.samples);

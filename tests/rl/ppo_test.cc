@@ -108,6 +108,68 @@ TEST(Networks, OnlyTheCriticReadsTheCriticOnlyBlock) {
   }
 }
 
+// A source with 2 future frames widened to 4 acts and values as before, on
+// any values of the frames it never read (their weights start at zero), and
+// its normalizer carries over; the new frames' statistics start as its last
+// frame's. Only a longer horizon is widened.
+TEST(Networks, WideningTheFutureFramesKeepsTheSourcesActionsAndValues) {
+  torch::manual_seed(2);
+  const ObservationLayout short_layout = SmallLayout();
+  ObservationLayout long_layout = short_layout;
+  long_layout.num_future_frames = 4;
+  ActorCritic source(short_layout, SmallModel(), 4);
+  source->UpdateNormalizer(torch::randn({64, short_layout.size()}) * 3 + 1);
+  ActorCritic widened(long_layout, SmallModel(), 4);
+  WidenFutureFrames(*source, *widened);
+
+  const int64_t frame_width =
+      short_layout.num_points * ObservationLayout::kPointFeatures;
+  for (int views : {1, 2}) {
+    SCOPED_TRACE(views);
+    torch::Tensor base = torch::randn({5, short_layout.view_offset()});
+    std::vector<torch::Tensor> short_parts = {base}, long_parts = {base};
+    for (int k = 0; k < views; ++k) {
+      torch::Tensor block = torch::randn({5, short_layout.view_size()});
+      short_parts.push_back(block);
+      long_parts.push_back(block);
+      long_parts.push_back(torch::randn({5, 2 * frame_width}) * 10);
+    }
+    const torch::Tensor short_obs =
+        source->Normalize(torch::cat(short_parts, 1));
+    const torch::Tensor long_obs =
+        widened->Normalize(torch::cat(long_parts, 1));
+    EXPECT_TRUE(torch::allclose(source->ActionMean(short_obs, views),
+                                widened->ActionMean(long_obs, views), 1e-5,
+                                1e-6));
+    EXPECT_TRUE(torch::allclose(source->Value(short_obs, views),
+                                widened->Value(long_obs, views), 1e-5, 1e-6));
+  }
+  // The new frames are read once training moves their weights.
+  auto parameters = widened->named_parameters();
+  EXPECT_TRUE(parameters["actor_encoder.0.weight"]
+                  .narrow(1, short_layout.view_size(), 2 * frame_width)
+                  .abs()
+                  .sum()
+                  .item<double>() == 0.0);
+  auto buffers = widened->named_buffers();
+  auto source_buffers = source->named_buffers();
+  const torch::Tensor last_frame_mean =
+      source_buffers["view_normalizer.mean"].narrow(
+          0, short_layout.view_size() - frame_width, frame_width);
+  for (int frame = 3; frame <= 4; ++frame) {
+    EXPECT_TRUE(torch::equal(buffers["view_normalizer.mean"].narrow(
+                                 0, frame * frame_width, frame_width),
+                             last_frame_mean));
+  }
+
+  // Not a shorter horizon, nor other networks.
+  EXPECT_THROW(WidenFutureFrames(*widened, *source), ConfigError);
+  ModelOptions wider = SmallModel();
+  wider.encoder_hidden = {24};
+  ActorCritic other(long_layout, wider, 4);
+  EXPECT_THROW(WidenFutureFrames(*source, *other), ConfigError);
+}
+
 TEST(Networks, ABf16ScopeRoundsOnlyWithinItAndStaysNearFloat32) {
   torch::manual_seed(4);
   ObservationLayout layout = SmallLayout();

@@ -396,6 +396,47 @@ TEST(Resume, InitFromStartsAFreshRunFromAnotherRunsNetworks) {
   EXPECT_DOUBLE_EQ(starting_rate("adaptive", 1e-6), 7e-5);
   EXPECT_DOUBLE_EQ(starting_rate("adaptive_floor", 1e-4), 1e-4);
 
+  // A longer horizon of future frames: the source's weights, its encoders'
+  // first layers widened with zero columns for the new frames.
+  TrainConfig longer = tuned;
+  longer.run.run_dir = dir + "/longer";
+  longer.env.num_future_frames = config.env.num_future_frames + 3;
+  {
+    Trainer trainer(longer, /*resume=*/false);
+    trainer.SaveCheckpoint();
+  }
+  ActorCritic d = ReadModel(longer.run.run_dir + "/checkpoint.pt", &started);
+  EXPECT_EQ(d->layout().num_future_frames, config.env.num_future_frames + 3);
+  const int64_t source_width = a->layout().view_size();
+  for (const auto& item : d->named_parameters()) {
+    const torch::Tensor source = a_state[item.key()];
+    if (source.sizes() == item.value().sizes()) {
+      EXPECT_TRUE(torch::equal(item.value(), source)) << item.key();
+    } else {
+      EXPECT_TRUE(torch::equal(item.value().narrow(1, 0, source_width), source))
+          << item.key();
+      EXPECT_EQ(
+          item.value()
+              .narrow(1, source_width, item.value().size(1) - source_width)
+              .abs()
+              .sum()
+              .item<double>(),
+          0.0)
+          << item.key();
+    }
+  }
+  // A shorter one is not widened: an error naming the checkpoint.
+  TrainConfig shorter = tuned;
+  shorter.run.run_dir = dir + "/shorter";
+  shorter.env.num_future_frames = config.env.num_future_frames - 1;
+  try {
+    Trainer trainer(shorter, /*resume=*/false);
+    ADD_FAILURE() << "a shorter horizon was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(pretrained), std::string::npos)
+        << e.what();
+  }
+
   // Networks of other sizes: an error naming the checkpoint.
   TrainConfig other_sizes = tuned;
   other_sizes.run.run_dir = dir + "/other_sizes";
