@@ -454,15 +454,20 @@ AveragedCheckpointSummary AverageCheckpoints(
   // networks (LoadCheckpoint names a file whose networks or layout differ)
   // and is summed into the running total.
   std::vector<int64_t> input_samples;
-  for (const std::string& input : inputs)
-    input_samples.push_back(ReadCheckpointInfo(input).counters.samples);
-  const size_t newest = static_cast<size_t>(
-      std::max_element(input_samples.begin(), input_samples.end()) -
-      input_samples.begin());
+  size_t newest = 0;
+  CheckpointInfo newest_info;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    CheckpointInfo info = ReadCheckpointInfo(inputs[i]);
+    input_samples.push_back(info.counters.samples);
+    if (i == 0 || info.counters.samples > input_samples[newest]) {
+      newest = i;
+      newest_info = std::move(info);
+    }
+  }
   const std::string& base = inputs[newest];
-  const TrainConfig config = ReadCheckpointConfig(base);
-  int action_size = 0;
-  const ObservationLayout layout = ReadCheckpointLayout(base, &action_size);
+  const TrainConfig& config = newest_info.config;
+  const ObservationLayout& layout = newest_info.layout;
+  const int action_size = newest_info.action_size;
   ActorCritic mean_model(layout, config.model, action_size);
   torch::optim::Adam optimizer(
       mean_model->parameters(),
