@@ -19,6 +19,7 @@
 #include "common/file_io.h"
 #include "env/reference.h"
 #include "env/reference_stream.h"
+#include "eval/evaluator.h"
 #include "fit/camera_model.h"
 #include "fit/fit.h"
 #include "fit/fit_config.h"
@@ -344,8 +345,11 @@ int RunTrackedGenerations(const GenerateArgs& args) {
   const TrainConfig& config = policy.config();
   const auto character = LoadCharacterForSimulation(
       TrainedCharacterPath(config), config.data.scene, config.env.simulation);
-  TrackingEnvOptions env_options = config.env;
-  env_options.max_episode_s = args.seconds;
+  // Judged by the success rule (the worst keypoint within 100 px), not by
+  // training's early exit, which may be stricter; no pushes.
+  EvalOptions judged;
+  judged.episode_s = args.seconds;
+  const TrackingEnvOptions env_options = JudgedEnvOptions(config.env, judged);
   const int root = character->root_qpos_address();
   const int root_dof = character->root_dof_address();  // world-frame velocity
   const std::vector<TrackedSource> sources = TrackedSources(args);

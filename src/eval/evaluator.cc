@@ -44,6 +44,23 @@ RolloutEnd EndOf(const StepOutcome& outcome) {
 
 }  // namespace
 
+TrackingEnvOptions JudgedEnvOptions(const TrackingEnvOptions& trained,
+                                    const EvalOptions& options) {
+  TrackingEnvOptions judged = trained;
+  // The early exit exactly at the success rule.
+  judged.early_exit = true;
+  judged.early_exit_max_error_px = options.success_threshold_px;
+  judged.early_exit_measure = options.success_measure;
+  judged.max_episode_s = options.episode_s;
+  // Every policy is judged by the same 2D criterion, whatever it was
+  // trained to follow (a 3D baseline's own 3D exit is off).
+  judged.reward_3d.early_exit_max_error_m = 0.0;
+  judged.pushes = options.pushes;
+  judged.object_start_square_m = options.object_start_square_m;
+  if (options.camera) judged.camera = *options.camera;
+  return judged;
+}
+
 const char* RolloutEndName(RolloutEnd end) {
   switch (end) {
     case RolloutEnd::kEarlyExit:
@@ -111,20 +128,9 @@ std::vector<EvalRow> EvaluatePolicy(
                                        std::to_string(options.num_views) +
                                        " views to track at once");
   }
-  // The evaluation episode: early exit exactly at the success threshold.
   // Episodes start from the given initial states (noise-free ones for
   // evaluation: callers build them with sigma 0).
-  TrackingEnvOptions eval_env = env_options;
-  eval_env.early_exit = true;
-  eval_env.early_exit_max_error_px = options.success_threshold_px;
-  eval_env.early_exit_measure = options.success_measure;
-  eval_env.max_episode_s = options.episode_s;
-  // Every policy is judged by the same 2D criterion, whatever it was
-  // trained to follow (a 3D baseline's own 3D exit is off).
-  eval_env.reward_3d.early_exit_max_error_m = 0.0;
-  eval_env.pushes = options.pushes;
-  eval_env.object_start_square_m = options.object_start_square_m;
-  if (options.camera) eval_env.camera = *options.camera;
+  const TrackingEnvOptions eval_env = JudgedEnvOptions(env_options, options);
   if (options.object_start_square_m > 0 &&
       reference->num_object_points() == 0) {
     throw InputError("evaluation",

@@ -48,6 +48,15 @@ struct EvalOptions {
   void Validate() const;  // throws ConfigError
 };
 
+// The environment a rollout is judged in: the policy's training options
+// with the early exit exactly at the success rule (threshold and measure),
+// episodes of options.episode_s, the perturbations options asks for (none by
+// default) and a 3D baseline's own 3D exit off. Training's exit may be
+// stricter or looser than the rule (env.early_exit_max_error_px); every
+// policy is judged by the same rule whatever it trained with. Pure.
+TrackingEnvOptions JudgedEnvOptions(const TrackingEnvOptions& trained,
+                                    const EvalOptions& options);
+
 // What ended a rollout.
 enum class RolloutEnd {
   kEarlyExit,  // a frame over the success threshold (or behind a camera)

@@ -331,6 +331,38 @@ TEST(EvaluatePolicy, InvalidOptionsAreRejected) {
                ConfigError);
 }
 
+// A policy trained with a stricter (or looser) early exit, with pushes or
+// with a 3D exit is judged by the success rule alone: the rule's threshold
+// and measure, the evaluation's length, no pushes unless asked for; the
+// rest (simulation, horizon, reward) is the training's.
+TEST(EvaluatePolicy, EveryPolicyIsJudgedByTheSuccessRuleNotItsTrainingExit) {
+  TrackingEnvOptions trained;
+  trained.early_exit = false;
+  trained.early_exit_max_error_px = 50.0;
+  trained.early_exit_measure = FrameErrorMeasure::kMean;
+  trained.pushes.force_n = 100.0;
+  trained.reward_3d.early_exit_max_error_m = 0.5;
+  trained.num_future_frames = 7;
+  trained.max_episode_s = 10.0;
+  EvalOptions options;
+  options.episode_s = 60.0;
+  const TrackingEnvOptions judged = JudgedEnvOptions(trained, options);
+  EXPECT_TRUE(judged.early_exit);
+  EXPECT_EQ(judged.early_exit_max_error_px, 100.0);
+  EXPECT_EQ(judged.early_exit_measure, FrameErrorMeasure::kWorst);
+  EXPECT_EQ(judged.pushes.force_n, 0.0);
+  EXPECT_EQ(judged.reward_3d.early_exit_max_error_m, 0.0);
+  EXPECT_EQ(judged.max_episode_s, 60.0);
+  EXPECT_EQ(judged.num_future_frames, 7);
+  options.success_threshold_px = 80.0;
+  options.success_measure = FrameErrorMeasure::kMean;
+  options.pushes.force_n = 300.0;
+  const TrackingEnvOptions asked = JudgedEnvOptions(trained, options);
+  EXPECT_EQ(asked.early_exit_max_error_px, 80.0);
+  EXPECT_EQ(asked.early_exit_measure, FrameErrorMeasure::kMean);
+  EXPECT_EQ(asked.pushes.force_n, 300.0);
+}
+
 // Pushes start every every_s into an episode (not at its start) and last
 // duration_s, whole control steps at the control rate.
 TEST(EvaluatePolicy, PushesFollowTheirScheduleInControlSteps) {
