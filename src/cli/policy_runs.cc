@@ -320,8 +320,11 @@ EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
     throw ConfigError("--start-frame must be in [0, " +
                       std::to_string(bundle.num_frames() - 2) + "]");
   }
-  TrackingEnvOptions env_options = config.env;
-  env_options.max_episode_s = episode_s;
+  // The rollout ends as eval's would (the success rule, no pushes), not at
+  // training's own early exit.
+  EvalOptions judged;
+  judged.episode_s = episode_s;
+  const TrackingEnvOptions env_options = JudgedEnvOptions(config.env, judged);
   TrackingEnv env(character, task.reference, task.initial_states, env_options,
                   0);
   RecordedFrames frames(RecordPolicyRollout(

@@ -69,7 +69,9 @@ void WriteEvalFramesCsv(const std::string& path,
                         const CheckpointEvaluation& evaluation);
 
 // Rolls the checkpoint's policy out on `replay.view` of `bundle` from
-// `start_frame` for at most `episode_s`, and draws it as `replay` says.
+// `start_frame` for at most `episode_s`, ending as eval's rollouts do
+// (JudgedEnvOptions: the success rule, no pushes), and draws it as
+// `replay` says.
 EpisodeSummary RenderCheckpointRollout(const std::string& checkpoint,
                                        const ReferenceBundle& bundle,
                                        const BundleReplayOptions& replay,

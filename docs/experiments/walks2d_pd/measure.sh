@@ -24,6 +24,8 @@
 # START_TILT: generate's --start-tilt: view (the default since 2026-12-07's
 # second session: the start fits hold --view's tilt) or fit (estimated, as
 # every figure before it).
+# MIMIC2D: the binary (default build/mimic2d; a copy lets the build change
+# while a measure runs).
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 checkpoint=$1 out=$2
@@ -36,13 +38,13 @@ first_draw=${FIRST_DRAW:-0}
 for ((draw = first_draw; draw < first_draw + ${DRAWS:-1}; ++draw)); do
   suffix=""
   [ "$draw" -gt 0 ] && suffix="_$draw"
-  build/mimic2d generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
+  ${MIMIC2D:-build/mimic2d} generate runs/gen_walks --seconds 60 --view 30,15,4.5 \
     "${start_options[@]}" --policy "$checkpoint" --generations 9 --each-motion --azimuths 30,210 \
     --seed $((9 * draw + 1)) -o "${out}_generated${suffix}.json" \
     --frames "${out}_frames${suffix}.csv" \
     > "${out}_generated${suffix}.log" 2>&1
   grep -E "generation|^Succ" "${out}_generated${suffix}.log"
 done
-build/mimic2d eval "$checkpoint" --episodes 2 --episode-s 10 \
+${MIMIC2D:-build/mimic2d} eval "$checkpoint" --episodes 2 --episode-s 10 \
   -o "${out}_eval.json" > "${out}_eval.log" 2>&1
 tail -n 45 "${out}_eval.log"
